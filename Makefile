@@ -1,0 +1,36 @@
+# Two commands do all the set-up on a fresh machine (see README):
+#   make demo   - whole pipeline on sample_data/ into a local SQLite database
+#   make test   - the test suite
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+OUT ?= out
+
+.PHONY: demo test bench sample-data clean system-deps
+
+# Debian's venv module is a separate package; install it only where it is missing.
+system-deps:
+	@$(PYTHON) -c "import ensurepip, venv" 2>/dev/null || \
+	  (apt-get update -qq && apt-get install -y -qq python3-venv)
+
+$(STAMP): pyproject.toml | system-deps
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -e '.[test]'
+	touch $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/swtlab demo sample_data/campaign --out $(OUT)
+
+test: $(STAMP)
+	$(BIN)/python -m pytest -q
+
+bench: $(STAMP)
+	$(BIN)/python -m bench
+
+sample-data: $(STAMP)
+	$(BIN)/python -m virtual_testbed.sample_campaign --out sample_data --seed 20260
+
+clean:
+	rm -rf $(VENV) $(OUT) *.egg-info

@@ -1,0 +1,1 @@
+"""fitting: not built yet (see the issues)."""

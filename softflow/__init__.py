@@ -1,0 +1,1 @@
+"""softflow: not built yet (see the issues)."""

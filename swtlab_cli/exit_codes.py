@@ -1,0 +1,13 @@
+"""Exit codes of the ``swtlab`` command, documented in ``swtlab --help`` and the README."""
+
+OK = 0  # the command did its job (a batch may still report runs it could not use)
+USAGE = 2  # bad command line (argparse's own code)
+BAD_INPUT = 3  # the input could not be used at all: unreadable file, nothing processed
+INTERNAL = 4  # an unexpected error inside swtlab: please report it
+
+EPILOG = """exit codes:
+  0  done (a batch may still list runs it could not use, each with its reason)
+  2  bad command line
+  3  bad input: nothing could be read or processed (the message names file, channel, problem)
+  4  unexpected internal error (please report it with the command line)
+"""

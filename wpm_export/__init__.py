@@ -1,0 +1,1 @@
+"""wpm_export: not built yet (see the issues)."""
