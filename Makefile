@@ -21,7 +21,9 @@ $(STAMP): pyproject.toml | system-deps
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/swtlab demo sample_data/campaign --out $(OUT)
+	mkdir -p $(OUT)
+	$(BIN)/swtlab ingest sample_data/campaign --db sqlite:///$(OUT)/swtlab.sqlite
+	@echo "results: $(OUT)/swtlab.sqlite (SQLite; try: $(BIN)/swtlab inspect <run>)"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -12,7 +12,7 @@ import sys
 
 from swtlab_cli import exit_codes
 
-SUBCOMMANDS = ["inspect", "demo", "sim"]
+SUBCOMMANDS = ["inspect", "ingest", "sim"]
 
 
 def _version() -> str:

@@ -1,0 +1,129 @@
+"""ORM tables of the traceability database (SQLAlchemy 2 typed declarative mapping).
+
+Every derived row points at the ``processing_record`` that made it (swtlab
+version, stage, parameters, time), so any number traces back to raw files.
+"""
+
+from __future__ import annotations
+
+from datetime import datetime
+
+from sqlalchemy import JSON, DateTime, Float, ForeignKey, Integer, String, UniqueConstraint
+from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
+
+
+class Base(DeclarativeBase):
+    pass
+
+
+class ProcessingRecord(Base):
+    """Who made a row: swtlab version, pipeline stage, its parameters, when."""
+
+    __tablename__ = "processing_record"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    swtlab_version: Mapped[str] = mapped_column(String(40))
+    stage: Mapped[str] = mapped_column(String(40))
+    parameters: Mapped[dict] = mapped_column(JSON, default=dict)
+    created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True))
+
+
+class Campaign(Base):
+    __tablename__ = "campaign"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(200), unique=True)
+
+
+class Wheel(Base):
+    """A wheel as the metadata describes it; one row per distinct geometry under a name."""
+
+    __tablename__ = "wheel"
+    __table_args__ = (UniqueConstraint("name", "radius_m", "width_m", "grouser_count",
+                                       "grouser_height_m", "stiffness_n_per_mm"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(200))
+    radius_m: Mapped[float] = mapped_column(Float)
+    width_m: Mapped[float] = mapped_column(Float)
+    grouser_count: Mapped[int] = mapped_column(Integer)
+    grouser_height_m: Mapped[float] = mapped_column(Float)
+    stiffness_n_per_mm: Mapped[float | None] = mapped_column(Float, nullable=True)
+    mass_kg: Mapped[float | None] = mapped_column(Float, nullable=True)
+
+
+class Soil(Base):
+    __tablename__ = "soil"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    name: Mapped[str] = mapped_column(String(200), unique=True)
+
+
+class TestCondition(Base):
+    """The set point of a run: mode, load, slip, velocity, soil pass, gravity, steer."""
+
+    __tablename__ = "test_condition"
+    __test__ = False  # not a pytest class
+    id: Mapped[int] = mapped_column(primary_key=True)
+    campaign_id: Mapped[int] = mapped_column(ForeignKey("campaign.id"))
+    wheel_id: Mapped[int] = mapped_column(ForeignKey("wheel.id"))
+    soil_id: Mapped[int] = mapped_column(ForeignKey("soil.id"))
+    mode: Mapped[str] = mapped_column(String(20))
+    multipass: Mapped[int] = mapped_column(Integer)
+    load_n: Mapped[float] = mapped_column(Float)
+    slip_setpoint: Mapped[float | None] = mapped_column(Float, nullable=True)
+    velocity_mps: Mapped[float] = mapped_column(Float)
+    gravity_mps2: Mapped[float] = mapped_column(Float)
+    steer_deg: Mapped[float | None] = mapped_column(Float, nullable=True)
+
+    wheel: Mapped[Wheel] = relationship()
+    soil: Mapped[Soil] = relationship()
+
+
+class Run(Base):
+    """One drive through the bin, identified by (campaign, run_id) from its metadata."""
+
+    __tablename__ = "run"
+    __table_args__ = (UniqueConstraint("campaign_id", "run_id"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    campaign_id: Mapped[int] = mapped_column(ForeignKey("campaign.id"))
+    run_id: Mapped[str] = mapped_column(String(200))
+    condition_id: Mapped[int] = mapped_column(ForeignKey("test_condition.id"))
+    started_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True), nullable=True)
+
+    campaign: Mapped[Campaign] = relationship()
+    condition: Mapped[TestCondition] = relationship()
+    raw_files: Mapped[list[RawFile]] = relationship(back_populates="run",
+                                                    order_by="RawFile.version")
+
+
+class RawFile(Base):
+    """One version of a run's raw file (or CSV run folder); a changed file is a new version."""
+
+    __tablename__ = "raw_file"
+    __table_args__ = (UniqueConstraint("run_pk", "version"), UniqueConstraint("run_pk", "sha256"))
+    id: Mapped[int] = mapped_column(primary_key=True)
+    run_pk: Mapped[int] = mapped_column(ForeignKey("run.id"))
+    version: Mapped[int] = mapped_column(Integer)
+    path: Mapped[str] = mapped_column(String(1000))
+    size_bytes: Mapped[int] = mapped_column(Integer)
+    sha256: Mapped[str] = mapped_column(String(64))
+    file_format: Mapped[str] = mapped_column(String(40))
+    channel_summary: Mapped[dict] = mapped_column(JSON)
+    problems: Mapped[list] = mapped_column(JSON)
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    run: Mapped[Run] = relationship(back_populates="raw_files")
+    processing: Mapped[ProcessingRecord] = relationship()
+    calibrations: Mapped[list[Calibration]] = relationship(back_populates="raw_file")
+
+
+class Calibration(Base):
+    """A gain/offset or a tare (zero offset) applied to one channel of one raw file."""
+
+    __tablename__ = "calibration"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    raw_file_id: Mapped[int] = mapped_column(ForeignKey("raw_file.id"))
+    kind: Mapped[str] = mapped_column(String(20))  # "gain_offset" or "zero"
+    topic: Mapped[str] = mapped_column(String(200))
+    field: Mapped[str] = mapped_column(String(100))
+    gain: Mapped[float] = mapped_column(Float)
+    offset: Mapped[float] = mapped_column(Float)
+
+    raw_file: Mapped[RawFile] = relationship(back_populates="calibrations")
