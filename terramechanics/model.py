@@ -1,0 +1,203 @@
+"""The single-wheel model: wheel, soil, gravity and the effects switched on.
+
+Forces of the Wong-Reece stress distribution (Wong & Reece 1967; Wong, Theory of
+Ground Vehicles 2008, ch. 2), angles from the vertical, positive forward::
+
+    Fz = b int (r_c sigma cos(t) + r_s tau sin(t)) dt
+    DP = b int (r_s tau cos(t) - r_c sigma sin(t)) dt
+    T  = (r - delta + lambda h) b r_s int tau dt
+
+over [theta_2, theta_1]; r_c is the contact radius (r for a rigid wheel), r_s the
+shear radius (r_c + lambda h with grousers). The sinkage solves W = Fz.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from terramechanics import stress
+from terramechanics.effects import EFFECTS, Effect, make_effect
+from terramechanics.equilibrium import solve_increasing
+from terramechanics.soil import SoilParams
+from terramechanics.state import (EARTH_GRAVITY_MPS2, Condition, Contact, Geometry,
+                                  SoilState)
+from terramechanics.wheel import Wheel
+
+CONVERGED_REL = 1e-3  # |W - Fz| < 0.1 % W
+
+
+@dataclass(frozen=True)
+class WheelModel:
+    """Rigid-wheel terramechanics model; ``effects`` maps effect name -> parameters."""
+
+    wheel: Wheel
+    soil: SoilParams
+    gravity_mps2: float = EARTH_GRAVITY_MPS2
+    effects: dict[str, Effect] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        unknown = set(self.effects) - set(EFFECTS)
+        if unknown:
+            raise KeyError(f"unknown effect(s) {sorted(unknown)}; known: {sorted(EFFECTS)}")
+        ordered = {name: self.effects[name] for name in EFFECTS if name in self.effects}
+        object.__setattr__(self, "effects", ordered)
+
+    # -- switching effects and parameters -------------------------------------------------
+    def with_effects(self, **changes: bool | dict | Effect | None) -> WheelModel:
+        """Switch effects: ``True`` on (current or default parameters), ``False``/``None``
+        off, a dict of parameters (merged into the current ones) or an ``Effect``."""
+        effects = dict(self.effects)
+        for name, change in changes.items():
+            if change is None or change is False:
+                effects.pop(name, None)
+            elif change is True:
+                effects[name] = effects.get(name) or make_effect(name)
+            elif isinstance(change, Effect):
+                effects[name] = change
+            else:
+                current = effects.get(name) or make_effect(name)
+                effects[name] = replace(current, **change)
+        return replace(self, effects=effects)
+
+    def with_soil(self, **changes: float) -> WheelModel:
+        return replace(self, soil=replace(self.soil, **changes))
+
+    def with_wheel(self, **changes: float) -> WheelModel:
+        return replace(self, wheel=replace(self.wheel, **changes))
+
+    def parameters(self) -> dict[str, float]:
+        """Every numeric parameter under a dotted name (``soil.kphi``,
+        ``effects.grousers.shear_radius_factor``, ``gravity_mps2``)."""
+        out: dict[str, float] = {"gravity_mps2": self.gravity_mps2}
+        for prefix, obj in [("wheel", self.wheel), ("soil", self.soil)] + [
+                (f"effects.{name}", eff) for name, eff in self.effects.items()]:
+            for f in dataclasses.fields(obj):
+                value = getattr(obj, f.name)
+                if isinstance(value, (int, float)) and not isinstance(value, bool):
+                    out[f"{prefix}.{f.name}"] = value
+        return out
+
+    def with_parameters(self, values: dict[str, float]) -> WheelModel:
+        """A copy with dotted-name parameters changed (see :meth:`parameters`); naming
+        ``effects.<name>.<param>`` switches that effect on."""
+        model = self
+        for key, value in values.items():
+            head, _, rest = key.partition(".")
+            if key == "gravity_mps2":
+                model = replace(model, gravity_mps2=float(value))
+            elif head == "soil":
+                model = model.with_soil(**{rest: value})
+            elif head == "wheel":
+                model = model.with_wheel(**{rest: value})
+            elif head == "effects" and "." in rest:
+                name, _, param = rest.partition(".")
+                model = model.with_effects(**{name: {param: value}})
+            else:
+                raise KeyError(f"unknown parameter {key!r}")
+        return model
+
+    # -- evaluation --------------------------------------------------------------------------
+    def curves(self, load_n, slip, multipass=0, gravity_mps2=None) -> dict[str, np.ndarray]:
+        """Wheel performance at every (load, slip, multipass, gravity), broadcast together.
+
+        Inputs: wheel load W (N) at the model's (or the given) gravity, slip (driving
+        ``(r w - v)/(r w)`` >= 0, skid ``(r w - v)/v`` in [-1, 0)), multipass index
+        (previous passes; acts with the ``multipass`` effect), gravity (m/s^2; acts
+        with ``reduced_gravity``). Outputs (SI): ``dp_n``, ``torque_nm``,
+        ``sinkage_m``, ``resistance_n = T/r - DP``, ``thrust_n``,
+        ``compaction_resistance_n``, ``fz_n``, ``fz_residual_n = W - Fz``,
+        ``converged``, ``theta1_rad``, ``theta2_rad``, ``thetam_rad`` and the named
+        terms of every effect (zero where off).
+        """
+        g = self.gravity_mps2 if gravity_mps2 is None else gravity_mps2
+        arrays = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+                                       for x in (load_n, slip, multipass, g)))
+        if np.any(arrays[0] <= 0):
+            raise ValueError("load_n must be > 0")
+        cond = Condition(*(a.copy() for a in arrays))
+        soil, geo = self._soil_state(cond), self._base_geometry(cond)
+        for effect in self.effects.values():
+            soil = effect.soil(soil, cond, self.wheel)
+            geo = effect.geometry(geo, cond, self.wheel)
+        contact_forces = _ContactForces(soil, geo, cond)
+        z_max = np.full(cond.slip.shape, self.wheel.radius_m)
+        sinkage, residual = solve_increasing(lambda z: contact_forces(z)["fz_n"],
+                                             np.full_like(z_max, 1e-9 * self.wheel.radius_m),
+                                             z_max, cond.load_n)
+        out = contact_forces(sinkage)
+        contact = Contact(sinkage, out["theta1_rad"], out["theta2_rad"], out["thetam_rad"],
+                          out.pop("exit_shear_displacement_m"))
+        terms = {t: np.zeros(cond.slip.shape) for cls in EFFECTS.values() for t in cls.terms}
+        dp, torque = out.pop("dp_soil_n"), out.pop("torque_soil_nm")
+        for effect in self.effects.values():
+            extra = effect.forces(contact, soil, geo, cond, self.wheel)
+            dp, torque = dp + extra.dp_n, torque + extra.torque_nm
+            terms.update(extra.terms)
+        return {
+            "load_n": cond.load_n, "slip": cond.slip, "multipass": cond.multipass,
+            "gravity_mps2": cond.gravity_mps2, "dp_n": dp, "torque_nm": torque,
+            "sinkage_m": sinkage, "resistance_n": torque / self.wheel.radius_m - dp,
+            "thrust_n": out["thrust_n"] + terms["grouser_thrust_n"],
+            "compaction_resistance_n": out["compaction_resistance_n"],
+            "fz_n": out["fz_n"], "fz_residual_n": -residual,
+            "converged": np.abs(residual) < CONVERGED_REL * cond.load_n,
+            "theta1_rad": out["theta1_rad"], "theta2_rad": out["theta2_rad"],
+            "thetam_rad": out["thetam_rad"], **terms,
+        }
+
+    def _soil_state(self, cond: Condition) -> SoilState:
+        s, shape = self.soil, cond.slip.shape
+        full = lambda v: np.full(shape, float(v))  # noqa: E731
+        return SoilState(kc=full(s.kc), kphi=full(s.kphi), n0=full(s.n), n_slope=full(0.0),
+                         cohesion_pa=full(s.cohesion_pa),
+                         phi_rad=full(np.radians(s.friction_angle_deg)),
+                         shear_modulus_m=full(s.shear_modulus_m),
+                         unit_weight_n_m3=full(s.density_kg_m3 * EARTH_GRAVITY_MPS2),
+                         c1=full(s.c1), c2=full(s.c2), c3=full(s.c3))
+
+    def _base_geometry(self, cond: Condition) -> Geometry:
+        zeros = np.zeros(cond.slip.shape)
+        return Geometry(self.wheel.radius_m, self.wheel.width_m, zeros, zeros)
+
+
+class _ContactForces:
+    """Stress integrals at a trial sinkage, for fixed soil state, geometry and condition."""
+
+    def __init__(self, soil: SoilState, geo: Geometry, cond: Condition) -> None:
+        b = geo.width_m
+        self.soil, self.geo, self.width = soil, geo, b
+        self.k_reece = (soil.kc / b + soil.kphi) * b ** soil.n0
+        self.n = soil.n0 + soil.n_slope * np.abs(cond.slip)
+        self.slip = cond.slip
+        self.vel_ratio = stress.velocity_ratio(cond.slip)
+
+    def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
+        soil, geo, b = self.soil, self.geo, self.width
+        r_c = geo.contact_radius_m(sinkage_m)
+        r_s = r_c + geo.shear_offset_m
+        theta1 = np.arccos(np.clip(1.0 - sinkage_m / r_c, -1.0, 1.0))
+        theta2 = 0.0 - soil.c3 * theta1  # 0.0 - : no -0.0 in the output
+        thetam = stress.max_stress_angle(theta1, theta2, self.slip, soil.c1, soil.c2)
+        theta = np.concatenate([stress.region_grid(theta2, thetam)[0],
+                                stress.region_grid(thetam, theta1)[0]], axis=-1)
+        weights = np.concatenate([stress.region_grid(theta2, thetam)[1],
+                                  stress.region_grid(thetam, theta1)[1]], axis=-1)
+        sigma = stress.normal_stress(theta, theta1, theta2, thetam, self.k_reece, self.n, r_c, b)
+        j = stress.shear_displacement(theta, theta1, r_s, self.vel_ratio)
+        tau = stress.shear_stress(sigma, j, soil.cohesion_pa, soil.phi_rad, soil.shear_modulus_m)
+        cos, sin = np.cos(theta), np.sin(theta)
+        integral = lambda f: np.sum(f * weights, axis=-1)  # noqa: E731
+        thrust = b * r_s * integral(tau * cos)
+        compaction = b * r_c * integral(sigma * sin)
+        j_exit = stress.shear_displacement(theta2[..., None], theta1, r_s, self.vel_ratio)[..., 0]
+        return {
+            "fz_n": b * (r_c * integral(sigma * cos) + r_s * integral(tau * sin)),
+            "dp_soil_n": thrust - compaction,
+            "torque_soil_nm": (geo.arm_radius_m + geo.shear_offset_m) * b * r_s * integral(tau),
+            "thrust_n": thrust, "compaction_resistance_n": compaction,
+            "theta1_rad": theta1, "theta2_rad": theta2, "thetam_rad": thetam,
+            "exit_shear_displacement_m": j_exit,
+        }

@@ -1,0 +1,98 @@
+"""Model file (TOML): wheel, soil, gravity, effects. Format in ``docs/model-file.md``."""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from pathlib import Path
+
+from terramechanics.effects import EFFECTS, make_effect
+from terramechanics.model import WheelModel
+from terramechanics.soil import SOILS, SoilParams
+from terramechanics.state import EARTH_GRAVITY_MPS2
+from terramechanics.wheel import Wheel
+
+
+class ModelFileError(ValueError):
+    """A model file that cannot be used; the message names the table and key."""
+
+
+def _build(cls, table: dict, where: str):
+    try:
+        return cls(**table)
+    except TypeError as exc:
+        known = [f.name for f in dataclasses.fields(cls)]
+        raise ModelFileError(f"[{where}]: {exc}; known keys: {known}") from None
+    except ValueError as exc:
+        raise ModelFileError(f"[{where}]: {exc}") from None
+
+
+def model_from_dict(data: dict) -> WheelModel:
+    """Build a model from the parsed TOML tables."""
+    unknown = set(data) - {"model", "wheel", "soil", "effects"}
+    if unknown:
+        raise ModelFileError(f"unknown table(s) {sorted(unknown)}")
+    for table in ("wheel", "soil"):
+        if table not in data:
+            raise ModelFileError(f"missing table [{table}]")
+    wheel = _build(Wheel, data["wheel"], "wheel")
+    soil_table = dict(data["soil"])
+    preset = soil_table.pop("preset", None)
+    if preset is not None:
+        if preset not in SOILS:
+            raise ModelFileError(f"[soil] preset {preset!r} unknown; known: {sorted(SOILS)}")
+        soil_table = {**dataclasses.asdict(SOILS[preset]), **soil_table}
+    soil = _build(SoilParams, soil_table, "soil")
+    effects = {}
+    for name, table in data.get("effects", {}).items():
+        if name not in EFFECTS:
+            raise ModelFileError(f"[effects.{name}] unknown effect; known: {sorted(EFFECTS)}")
+        params = dict(table)
+        if params.pop("enabled", True):
+            try:
+                effects[name] = make_effect(name, **params)
+            except TypeError as exc:
+                raise ModelFileError(f"[effects.{name}]: {exc}") from None
+    gravity = data.get("model", {}).get("gravity_mps2", EARTH_GRAVITY_MPS2)
+    return WheelModel(wheel=wheel, soil=soil, gravity_mps2=float(gravity), effects=effects)
+
+
+def load_model(path: str | Path) -> WheelModel:
+    """Read a model file."""
+    try:
+        data = tomllib.loads(Path(path).read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelFileError(f"{path}: not valid TOML: {exc}") from None
+    return model_from_dict(data)
+
+
+def model_to_dict(model: WheelModel) -> dict:
+    """The tables of a model file; effects that are off are written with enabled = false."""
+    effects = {}
+    for name, cls in EFFECTS.items():
+        on = name in model.effects
+        effects[name] = {"enabled": on, **dataclasses.asdict(model.effects.get(name) or cls())}
+    return {"model": {"gravity_mps2": model.gravity_mps2},
+            "wheel": dataclasses.asdict(model.wheel), "soil": dataclasses.asdict(model.soil),
+            "effects": effects}
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    return '"' + str(value).replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def save_model(model: WheelModel, path: str | Path) -> None:
+    """Write a model file that :func:`load_model` reads back to an equal model."""
+    lines: list[str] = []
+    for table, content in model_to_dict(model).items():
+        if table == "effects":
+            for name, params in content.items():
+                lines += ["", f"[effects.{name}]"]
+                lines += [f"{k} = {_toml_value(v)}" for k, v in params.items()]
+        else:
+            lines += ["", f"[{table}]"] + [f"{k} = {_toml_value(v)}" for k, v in content.items()]
+    Path(path).write_text("\n".join(lines).lstrip() + "\n")
