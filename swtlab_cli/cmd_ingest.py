@@ -25,6 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import ingest
+    from ingest.inspect_report import report
     from traceability import open_database, store_ingested_run
     from traceability.store import StoreOutcome
 
@@ -48,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
         parameters = {"channel_map": str(args.channel_map) if args.channel_map else None,
                       "derivation": run_read.derivation}
         with session_factory.begin() as session:
-            _, outcome = store_ingested_run(session, run_read, ingest.channel_summary(run_read),
+            _, outcome = store_ingested_run(session, run_read, report(run_read)["streams"],
                                             parameters)
         counts[outcome] += 1
     read = sum(counts.values())

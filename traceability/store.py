@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import enum
 import json
-from dataclasses import asdict
 from datetime import datetime, timezone
 from importlib.metadata import version
 from pathlib import Path
@@ -69,6 +68,13 @@ def _calibrations(meta: Any) -> list[Calibration]:
     return rows
 
 
+def _file_format(run: Any) -> str:
+    """``mcap``, ``csv`` (spec run folder), or the name of the channel map that read it."""
+    if run.channel_map != "spec":
+        return f"map:{run.channel_map}"
+    return "mcap" if Path(run.source).suffix == ".mcap" else "csv"
+
+
 def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, Any],
                        parameters: dict[str, Any]) -> tuple[RawFile, StoreOutcome]:
     """Record ``run`` (an ``ingest.Run``) and its raw file; return the raw-file row and what changed.
@@ -96,8 +102,8 @@ def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, An
     last_version = session.scalar(select(func.max(RawFile.version)).filter_by(run_pk=db_run.id))
     raw_file = RawFile(run_pk=db_run.id, version=(last_version or 0) + 1,
                        path=str(Path(run.source).resolve()), size_bytes=size_bytes, sha256=sha256,
-                       file_format=run.file_format, channel_summary=channel_summary,
-                       problems=[asdict(p) for p in run.problems],
+                       file_format=_file_format(run), channel_summary=channel_summary,
+                       problems=[p.to_dict() for p in run.problems],
                        processing=new_processing_record(session, "ingest", parameters),
                        calibrations=_calibrations(meta))
     session.add(raw_file)
