@@ -1,0 +1,32 @@
+"""Test conditions of simulated runs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from virtual_testbed.law import STANDARD_GRAVITY_MPS2
+
+MODES = ("speed_control", "free_sled", "towed")
+#: 40 m/h, the travel velocity of the ESA/ExoMars SWT campaigns.
+VELOCITY_40_M_PER_H_MPS = 40.0 / 3600.0
+
+
+@dataclass(frozen=True)
+class RunCondition:
+    """One run: what the testbed operator sets (``slip_setpoint`` only for speed control)."""
+
+    run_id: str
+    mode: str
+    load_n: float
+    multipass: int = 0
+    slip_setpoint: float | None = None
+    velocity_mps: float = VELOCITY_40_M_PER_H_MPS
+    gravity_mps2: float = STANDARD_GRAVITY_MPS2
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise ValueError(f"mode {self.mode!r} not in {MODES}")
+        if (self.mode == "speed_control") != (self.slip_setpoint is not None):
+            raise ValueError("slip_setpoint is required for speed_control and only there")
+        if self.slip_setpoint is not None and not -1.0 < self.slip_setpoint < 1.0:
+            raise ValueError(f"slip_setpoint {self.slip_setpoint} outside (-1, 1)")

@@ -1,0 +1,71 @@
+"""The simulated rig: wheel geometry, parallel suspension and run timeline."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+
+@dataclass(frozen=True)
+class Wheel:
+    """Wheel geometry as written to ``swt.wheel`` (radius without grousers)."""
+
+    name: str
+    radius_m: float
+    width_m: float
+    grouser_count: int
+    grouser_height_m: float
+    stiffness_n_per_mm: float | None = None
+    mass_kg: float | None = None
+
+
+#: ExoMars BB2-like rigid wheel (radius 125 mm without grousers, 12 grousers of 9.2 mm).
+BB2_WHEEL = Wheel(name="BB2-like", radius_m=0.125, width_m=0.112, grouser_count=12,
+                  grouser_height_m=0.0092)
+
+
+@dataclass(frozen=True)
+class Suspension:
+    """Parallel-suspension arm: ``h = arm_length_m*(sin(angle) - sin(angle_zero_rad))``."""
+
+    arm_length_m: float = 0.60
+    angle_zero_rad: float = 0.05
+
+
+@dataclass(frozen=True)
+class Timeline:
+    """Phases of a run in seconds: rest, acceleration, transient, stable, stop.
+
+    The transient lasts ``settle_time_s`` after the end of the acceleration
+    (about 25 s at 40 m/h on ES-3); the stable phase runs from there until the
+    deceleration at the end of the bin.
+    """
+
+    rest_s: float = 2.0
+    accel_s: float = 2.0
+    settle_time_s: float = 25.0
+    stable_s: float = 28.0
+    decel_s: float = 2.0
+    rest_end_s: float = 1.0
+
+    @property
+    def motion_start_s(self) -> float:
+        return self.rest_s
+
+    @property
+    def window_start_s(self) -> float:
+        return self.rest_s + self.accel_s + self.settle_time_s
+
+    @property
+    def decel_start_s(self) -> float:
+        return self.window_start_s + self.stable_s
+
+    @property
+    def duration_s(self) -> float:
+        return self.decel_start_s + self.decel_s + self.rest_end_s
+
+    def with_duration(self, duration_s: float) -> "Timeline":
+        """Same phases, stable phase stretched or shrunk to the given total duration."""
+        stable_s = duration_s - (self.duration_s - self.stable_s)
+        if stable_s <= 0:
+            raise ValueError(f"duration {duration_s} s leaves no stable phase")
+        return replace(self, stable_s=stable_s)
