@@ -1,0 +1,53 @@
+"""A campaign: a folder of runs at any depth; reading it never stops on one bad run."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ingest.channel_map import ChannelMap, load_channel_map
+from ingest.errors import IngestError
+from ingest.run import Run, read_run
+
+
+@dataclass(frozen=True)
+class CampaignRead:
+    """Runs that ingested, and one IngestError per run that did not."""
+
+    root: Path
+    runs: list[Run] = field(default_factory=list)
+    failures: list[IngestError] = field(default_factory=list)
+
+
+def find_runs(root: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> list[Path]:
+    """Run files/folders under ``root`` (sorted): ``.mcap`` files and folders holding ``run.json``
+    for the spec form; files matching the map's ``files.pattern`` for a delimited map."""
+    root = Path(root)
+    cmap = load_channel_map(channel_map)
+    if not root.exists():
+        raise IngestError(root, None, "no such file or folder")
+    if cmap.format == "delimited":
+        if root.is_file():
+            return [root]
+        return sorted(p for p in root.rglob(cmap.file_pattern or "*") if p.is_file())
+    if root.is_file():
+        return [root] if root.suffix.lower() == ".mcap" else []
+    found = [p for p in root.rglob("*.mcap") if p.is_file()]
+    found += [p.parent for p in root.rglob("run.json")]
+    return sorted(found)
+
+
+def read_campaign(root: str | Path,
+                  channel_map: "str | Path | ChannelMap | None" = None) -> CampaignRead:
+    """Read every run under ``root``; a bad run becomes a failure, the batch goes on."""
+    cmap = load_channel_map(channel_map)
+    result = CampaignRead(root=Path(root))
+    for path in find_runs(root, cmap):
+        try:
+            result.runs.append(read_run(path, cmap))
+        except IngestError as exc:
+            result.failures.append(exc)
+        except Exception as exc:  # noqa: BLE001 - one line per run, the batch goes on
+            result.failures.append(IngestError(path, None, f"internal error while reading "
+                                               f"({type(exc).__name__}: {exc}); please report it"))
+    return result

@@ -1,0 +1,98 @@
+"""CSV form reader (spec: "CSV form"): ``run.json`` + one ``<topic>.csv`` per topic + frames."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ingest.channel_map import ChannelMap
+from ingest.errors import IngestError
+from ingest.raw import FrameIndex, RawRun, RawTopic
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv")
+
+
+def read_csv_run(folder: Path, cmap: ChannelMap) -> RawRun:
+    """Raw topics of a CSV run folder, the records of its ``run.json``, and its frames."""
+    folder = Path(folder)
+    meta_path = folder / "run.json"
+    try:
+        records = json.loads(meta_path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise IngestError(meta_path, None, f"cannot read: {exc.strerror}") from None
+    except ValueError as exc:
+        raise IngestError(meta_path, None, f"not valid JSON: {exc}") from None
+    if not isinstance(records, dict) or not all(isinstance(v, dict) for v in records.values()):
+        raise IngestError(meta_path, None, 'expected {"run": {...}, "wheel": {...}, ...}')
+    topics = {}
+    for topic in cmap.topics:
+        specs = cmap.channels_of(topic)
+        csv_path = folder / specs[0].csv_name
+        if csv_path.is_file():
+            topics[topic] = _read_topic(csv_path, cmap, {c.csv_column or c.field: c.field
+                                                         for c in specs})
+    frames = {}
+    side = _side_frames(folder)
+    if side is not None:
+        frames["/camera/side"] = side
+    track = folder / "camera_track"
+    if track.is_dir():
+        files = tuple(sorted(p for p in track.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES))
+        frames["/camera/track"] = FrameIndex("/camera/track", np.full(len(files), np.nan),
+                                             folder, files=files)
+    return RawRun(path=folder, records=records, topics=topics, frames=frames)
+
+
+def _read_topic(path: Path, cmap: ChannelMap, fields: dict[str, str]) -> RawTopic:
+    """One topic CSV: a header row, the time column first, then the fields (CSV column ->
+    source field name); other columns are ignored, absent ones are left to the coverage check."""
+    try:
+        frame = pd.read_csv(path, engine="c")
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise IngestError(path, None, f"cannot parse CSV: {exc}") from None
+    if len(frame.columns) == 0 or frame.columns[0] != cmap.time_column:
+        raise IngestError(path, cmap.time_column, f"first column must be {cmap.time_column!r} "
+                          f"(found {frame.columns[0] if len(frame.columns) else 'none'!r})")
+    wanted = {cmap.time_column: "t", **fields}
+    out = {}
+    for column, name in wanted.items():
+        if column not in frame.columns:
+            continue
+        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(np.float64)
+        bad = np.isnan(values) & frame[column].notna().to_numpy()
+        if bad.any():
+            row = int(np.argmax(bad))
+            raise IngestError(path, column, f"{int(bad.sum())} non-numeric values, first in "
+                              f"data row {row + 1}: {frame[column].iloc[row]!r}")
+        out[name] = values
+    t = out.pop("t") * cmap.time_scale_s
+    return RawTopic(t_s=t, fields=out)
+
+
+def _side_frames(folder: Path) -> FrameIndex | None:
+    """``camera_side/<t_ns>.png|jpg`` files, or ``camera_side.<video>`` with ``camera_side.csv``."""
+    images = folder / "camera_side"
+    if images.is_dir():
+        files = sorted((p for p in images.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES),
+                       key=lambda p: int(p.stem) if p.stem.isdigit() else -1)
+        bad = [p.name for p in files if not p.stem.isdigit()]
+        if bad:
+            raise IngestError(images / bad[0], "/camera/side", "frame names must be <t_ns>.png|jpg")
+        t_s = np.array([int(p.stem) for p in files], dtype=np.int64) * 1e-9
+        return FrameIndex("/camera/side", t_s, folder, files=tuple(files))
+    videos = [folder / f"camera_side{s}" for s in VIDEO_SUFFIXES
+              if (folder / f"camera_side{s}").is_file()]
+    if not videos:
+        return None
+    index = folder / "camera_side.csv"
+    try:
+        table = pd.read_csv(index)
+        t_s = table.sort_values("frame")["t_s"].to_numpy(np.float64)
+    except (OSError, KeyError, ValueError) as exc:
+        raise IngestError(index, "/camera/side",
+                          f"video needs camera_side.csv (frame, t_s): {exc}") from None
+    return FrameIndex("/camera/side", t_s, folder, video=videos[0])

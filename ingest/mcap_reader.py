@@ -1,0 +1,125 @@
+"""MCAP form reader (spec: "MCAP form"): JSON blocks of samples, metadata records, camera frames.
+
+One ``json.loads`` per block; samples are flattened per field with numpy, never
+one Python object per sample on our side.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import defaultdict
+from itertools import chain
+from pathlib import Path
+
+import numpy as np
+from mcap.reader import NonSeekingReader, make_reader
+
+from ingest.errors import IngestError
+from ingest.raw import FrameIndex, RawRun, RawTopic
+
+IMAGE_SCHEMA = "foxglove.CompressedImage"
+IMAGE_TOPICS = ("/camera/side", "/camera/track")
+_HINT = "the file is damaged or was cut short; re-export it (or try `mcap recover`)"
+
+
+def read_mcap(path: Path, topics: set[str]) -> RawRun:
+    """Raw topics (only those in ``topics``), ``swt.*`` records and image topics of one MCAP run."""
+    path = Path(path)
+    blocks: dict[str, list[bytes]] = defaultdict(list)
+    images: dict[str, list[bytes]] = defaultdict(list)
+    try:
+        with open(path, "rb") as stream:
+            reader = make_reader(stream, validate_crcs=True)
+            records = _swt_records(reader.iter_metadata())
+            if not records:  # no metadata index in the summary: scan the file for the records
+                stream.seek(0)
+                scan = NonSeekingReader(stream, validate_crcs=True)
+                records = _swt_records(scan.iter_metadata())
+                stream.seek(0)
+            for schema, channel, message in reader.iter_messages(log_time_order=False):
+                if channel.topic in IMAGE_TOPICS or (schema is not None
+                                                     and schema.name == IMAGE_SCHEMA):
+                    images[channel.topic].append(message.data)
+                elif channel.topic in topics:
+                    if channel.message_encoding != "json":
+                        raise IngestError(path, channel.topic, f"message encoding "
+                                          f"{channel.message_encoding!r}; the spec form uses json")
+                    blocks[channel.topic].append(message.data)
+    except IngestError:
+        raise
+    except OSError as exc:
+        raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
+    except Exception as exc:  # noqa: BLE001 - mcap raises many types for damaged files
+        raise IngestError(path, None, f"corrupt or truncated MCAP "
+                          f"({type(exc).__name__}: {exc}); {_HINT}") from None
+    raw_topics = {topic: _decode_blocks(path, topic, data) for topic, data in blocks.items()}
+    frames = {topic: _frame_index(path, topic, data) for topic, data in images.items()}
+    return RawRun(path=path, records=records, topics=raw_topics, frames=frames)
+
+
+def _swt_records(metadata) -> dict[str, dict[str, str]]:
+    """``swt.*`` metadata records by name without the prefix (other records are not ours)."""
+    return {m.name[4:]: dict(m.metadata) for m in metadata if m.name.startswith("swt.")}
+
+
+def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
+    """Concatenate a topic's blocks (ordered by their first time stamp) into field arrays."""
+    blocks = []
+    for i, message in enumerate(data):
+        try:
+            blocks.append(json.loads(message))
+        except (ValueError, UnicodeDecodeError) as exc:
+            raise IngestError(path, topic, f"message {i} is not valid JSON ({exc}); "
+                              f"{_HINT}") from None
+    names: list[str] | None = None
+    lengths = np.empty(len(blocks), dtype=np.int64)
+    for i, block in enumerate(blocks):
+        if not isinstance(block, dict) or "t_ns" not in block:
+            raise IngestError(path, topic, f"message {i} is not a block with t_ns")
+        if names is None:
+            names = list(block)
+        elif block.keys() != set(names):
+            raise IngestError(path, topic, f"message {i} has fields {sorted(block)}, "
+                              f"the first one {sorted(names)}")
+        sizes = {k: len(v) if isinstance(v, list) else -1 for k, v in block.items()}
+        if len(set(sizes.values())) != 1 or -1 in sizes.values():
+            raise IngestError(path, topic, f"message {i}: field arrays of different lengths "
+                              f"({', '.join(f'{k} {n}' for k, n in sizes.items())}); "
+                              "every field of a block must have one value per t_ns")
+        lengths[i] = sizes["t_ns"]
+    firsts = np.array([b["t_ns"][0] if b["t_ns"] else np.iinfo(np.int64).max for b in blocks])
+    blocks = [blocks[i] for i in np.argsort(firsts, kind="stable")]
+    total = int(lengths.sum())
+    t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64)
+    fields = {k: _flatten(path, topic, k, blocks, total, np.float64) for k in names if k != "t_ns"}
+    return RawTopic(t_s=t_ns * 1e-9, fields=fields)
+
+
+def _flatten(path: Path, topic: str, name: str, blocks: list[dict], total: int,
+             dtype: type) -> np.ndarray:
+    values = chain.from_iterable(b[name] for b in blocks)
+    try:
+        return np.fromiter(values, dtype=dtype, count=total)
+    except (TypeError, ValueError):
+        pass
+    try:  # JSON null (how many writers spell NaN) becomes NaN and is reported by the checks
+        out = np.array(list(chain.from_iterable(b[name] for b in blocks)), dtype=np.float64)
+    except (TypeError, ValueError):
+        raise IngestError(path, f"{topic}.{name}", "non-numeric values in the samples") from None
+    if dtype is np.int64:
+        if not np.isfinite(out).all():
+            raise IngestError(path, f"{topic}.t_ns", "missing (null) time stamps")
+        return out.astype(np.int64)
+    return out
+
+
+def _frame_index(path: Path, topic: str, data: list[bytes]) -> FrameIndex:
+    """Frame times from ``foxglove.CompressedImage`` messages (the images are not decoded)."""
+    t_s = np.full(len(data), np.nan)
+    for i, message in enumerate(data):
+        try:
+            stamp = json.loads(message)["timestamp"]
+            t_s[i] = float(stamp["sec"]) + float(stamp["nsec"]) * 1e-9
+        except (ValueError, KeyError, TypeError):
+            raise IngestError(path, topic, f"frame {i} has no timestamp {{sec, nsec}}") from None
+    return FrameIndex(topic=topic, t_s=t_s, source=path)

@@ -1,0 +1,304 @@
+"""Typed, validated run metadata (spec: "Metadata records").
+
+Records arrive as ``{record: {key: value}}`` with the ``swt.`` prefix dropped;
+values are strings (MCAP metadata) or JSON numbers (CSV ``run.json``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from ingest.errors import IngestError, Problem
+
+MODES = ("speed_control", "free_sled", "towed", "steered")
+WRENCH_FIELDS = ("fx", "fy", "fz", "tx", "ty", "tz")
+RECORDS = ("run", "wheel", "suspension", "camera", "camera_track", "zero", "calibration")
+
+_RUN_KEYS = {"run_id", "campaign", "wheel", "soil", "multipass", "mode", "load_N",
+             "slip_setpoint", "velocity_mps", "gravity_mps2", "steer_deg", "started_at",
+             "wheel_surface_speed_setpoint_mps"}
+_WHEEL_KEYS = {"radius_m", "width_m", "grouser_count", "grouser_height_m",
+               "stiffness_N_per_mm", "mass_kg"}
+_SUSPENSION_KEYS = {"arm_length_m", "angle_zero_rad"}
+_CAMERA_KEYS = {"px_per_m", "travel_direction", "wheel_center_px", "wheel_radius_px"}
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """``swt.run``. ``load_n`` is the set wheel load (spec key ``load_N``)."""
+
+    run_id: str
+    campaign: str
+    wheel: str
+    soil: str
+    multipass: int
+    mode: str
+    load_n: float
+    slip_setpoint: float | None
+    velocity_mps: float
+    gravity_mps2: float = 9.80665
+    steer_deg: float | None = None
+    started_at: datetime | None = None
+    #: set wheel surface speed r*omega, for rigs that impose it instead of slip (channel map)
+    wheel_surface_speed_setpoint_mps: float | None = None
+
+
+@dataclass(frozen=True)
+class WheelInfo:
+    """``swt.wheel``: radius without grousers; stiffness only for a flexible wheel."""
+
+    radius_m: float
+    width_m: float
+    grouser_count: int
+    grouser_height_m: float
+    stiffness_n_per_mm: float | None = None
+    mass_kg: float | None = None
+
+
+@dataclass(frozen=True)
+class SuspensionInfo:
+    """``swt.suspension``: h = arm_length_m * (sin(angle) - sin(angle_zero_rad))."""
+
+    arm_length_m: float
+    angle_zero_rad: float
+
+
+@dataclass(frozen=True)
+class CameraInfo:
+    """``swt.camera`` (side camera riding on the sled)."""
+
+    px_per_m: float
+    travel_direction: str = "+x"
+    wheel_center_px: tuple[float, float] | None = None
+    wheel_radius_px: float | None = None
+
+
+@dataclass(frozen=True)
+class CameraTrackInfo:
+    """``swt.camera_track`` (top view of the track)."""
+
+    px_per_m: float
+
+
+@dataclass(frozen=True)
+class RunMetadata:
+    """All metadata records of one run, typed and checked against each other."""
+
+    run: RunInfo
+    wheel: WheelInfo
+    suspension: SuspensionInfo | None = None
+    camera: CameraInfo | None = None
+    camera_track: CameraTrackInfo | None = None
+    zero: dict[str, float] = field(default_factory=dict)
+    calibration: dict[tuple[str, str], tuple[float, float]] = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """Plain JSON-ready dict (datetimes as ISO strings, calibration keys as 'topic.field')."""
+        from dataclasses import asdict
+
+        out = {}
+        for name in ("run", "wheel", "suspension", "camera", "camera_track"):
+            part = getattr(self, name)
+            out[name] = None if part is None else asdict(part)
+        if out["run"]["started_at"] is not None:
+            out["run"]["started_at"] = self.run.started_at.isoformat()
+        out["zero"] = dict(self.zero)
+        out["calibration"] = {f"{t}.{f}": {"gain": g, "offset": o}
+                              for (t, f), (g, o) in self.calibration.items()}
+        return out
+
+
+class _Reader:
+    """Typed access to one record; every failure is an IngestError naming record.key."""
+
+    def __init__(self, path: Path, name: str, values: Mapping[str, Any]):
+        self.path, self.name, self.values = path, name, values
+
+    def fail(self, key: str, problem: str) -> IngestError:
+        return IngestError(self.path, f"swt.{self.name}.{key}", problem)
+
+    def _get(self, key: str, required: bool, conv: Callable[[Any], Any], kind: str):
+        value = self.values.get(key)
+        if value is None or (isinstance(value, str) and not value.strip()):
+            if required:
+                raise self.fail(key, f"missing; add it to the swt.{self.name} metadata record")
+            return None
+        try:
+            return conv(value)
+        except (TypeError, ValueError):
+            raise self.fail(key, f"{value!r} is not {kind}") from None
+
+    def text(self, key: str, required: bool = True) -> str | None:
+        return self._get(key, required, lambda v: str(v).strip(), "text")
+
+    def number(self, key: str, required: bool = True) -> float | None:
+        value = self._get(key, required, float, "a number")
+        if value is not None and not math.isfinite(value):
+            raise self.fail(key, f"{value!r} is not a finite number")
+        return value
+
+    def integer(self, key: str, required: bool = True) -> int | None:
+        value = self.number(key, required)
+        if value is not None and value != int(value):
+            raise self.fail(key, f"{value!r} is not a whole number")
+        return None if value is None else int(value)
+
+    def positive(self, key: str, required: bool = True) -> float | None:
+        value = self.number(key, required)
+        if value is not None and value <= 0:
+            raise self.fail(key, f"{value:g} must be > 0")
+        return value
+
+
+def _unknown_keys(name: str, values: Mapping[str, Any], known: set[str]) -> list[Problem]:
+    return [Problem("warning", f"swt.{name}.{k}", "unknown metadata key, ignored")
+            for k in sorted(set(values) - known)]
+
+
+def _run_info(path: Path, values: Mapping[str, Any]) -> RunInfo:
+    r = _Reader(path, "run", values)
+    mode = r.text("mode")
+    if mode not in MODES:
+        raise r.fail("mode", f"unknown mode {mode!r}; use one of {', '.join(MODES)}")
+    load_n = r.number("load_N")
+    if load_n <= 0:
+        raise r.fail("load_N", f"{load_n:g} N: the set wheel load must be > 0")
+    slip = r.number("slip_setpoint", required=False)
+    velocity = r.number("velocity_mps")
+    if velocity < 0:
+        raise r.fail("velocity_mps", f"{velocity:g} m/s: the set travel velocity must be >= 0")
+    surface_speed = r.number("wheel_surface_speed_setpoint_mps", required=False)
+    if slip is None and mode in ("speed_control", "steered") and surface_speed is not None:
+        slip = _slip_from_speeds(surface_speed, velocity)
+    if mode in ("free_sled", "towed") and slip is not None:
+        raise r.fail("slip_setpoint", f"a {mode} run has no slip set-point; remove it or fix mode")
+    if mode == "speed_control" and slip is None:
+        raise r.fail("slip_setpoint", "missing; a speed_control run needs its slip set-point")
+    if slip is not None and not -1.0 <= slip <= 1.0:
+        raise r.fail("slip_setpoint", f"{slip:g} is outside [-1, 1] (a fraction, not percent)")
+    steer = r.number("steer_deg", required=False)
+    if mode == "steered" and steer is None:
+        raise r.fail("steer_deg", "missing; a steered run needs its steering angle")
+    if mode != "steered" and steer is not None:
+        raise r.fail("steer_deg", f"given for a {mode} run; only steered runs have one")
+    multipass = r.integer("multipass")
+    if multipass < 0:
+        raise r.fail("multipass", f"{multipass} must be >= 0 (0 = undisturbed soil)")
+    gravity = r.positive("gravity_mps2", required=False)
+    started = r.text("started_at", required=False)
+    try:
+        started_at = None if started is None else datetime.fromisoformat(started)
+    except ValueError:
+        raise r.fail("started_at", f"{started!r} is not an ISO 8601 date-time") from None
+    return RunInfo(run_id=r.text("run_id"), campaign=r.text("campaign"), wheel=r.text("wheel"),
+                   soil=r.text("soil"), multipass=multipass, mode=mode, load_n=load_n,
+                   slip_setpoint=slip, velocity_mps=velocity,
+                   gravity_mps2=9.80665 if gravity is None else gravity, steer_deg=steer,
+                   started_at=started_at, wheel_surface_speed_setpoint_mps=surface_speed)
+
+
+def _slip_from_speeds(surface_speed_mps: float, velocity_mps: float) -> float | None:
+    """Spec slip from set speeds: driving (rw - v)/rw, skid (rw - v)/v."""
+    denominator = max(surface_speed_mps, velocity_mps)
+    return None if denominator <= 0 else (surface_speed_mps - velocity_mps) / denominator
+
+
+def _wheel_info(path: Path, values: Mapping[str, Any]) -> WheelInfo:
+    r = _Reader(path, "wheel", values)
+    grousers = r.integer("grouser_count")
+    if grousers < 0:
+        raise r.fail("grouser_count", f"{grousers} must be >= 0")
+    height = r.number("grouser_height_m")
+    if height < 0:
+        raise r.fail("grouser_height_m", f"{height:g} must be >= 0")
+    return WheelInfo(radius_m=r.positive("radius_m"), width_m=r.positive("width_m"),
+                     grouser_count=grousers, grouser_height_m=height,
+                     stiffness_n_per_mm=r.positive("stiffness_N_per_mm", required=False),
+                     mass_kg=r.positive("mass_kg", required=False))
+
+
+def _camera_info(path: Path, values: Mapping[str, Any]) -> CameraInfo:
+    r = _Reader(path, "camera", values)
+    direction = r.text("travel_direction", required=False) or "+x"
+    if direction not in ("+x", "-x"):
+        raise r.fail("travel_direction", f"{direction!r}: use +x or -x")
+    centre = r.text("wheel_center_px", required=False)
+    if centre is not None:
+        try:
+            cx, cy = (float(v) for v in centre.strip("[]() ").split(","))
+        except ValueError:
+            raise r.fail("wheel_center_px", f"{centre!r} is not 'x,y'") from None
+        centre = (cx, cy)
+    return CameraInfo(px_per_m=r.positive("px_per_m"), travel_direction=direction,
+                      wheel_center_px=centre,
+                      wheel_radius_px=r.positive("wheel_radius_px", required=False))
+
+
+def _zero(path: Path, values: Mapping[str, Any]) -> dict[str, float]:
+    r = _Reader(path, "zero", values)
+    unknown = set(values) - set(WRENCH_FIELDS)
+    if unknown:
+        key = sorted(unknown)[0]
+        raise r.fail(key, f"not a wrench field; swt.zero takes {' '.join(WRENCH_FIELDS)}")
+    return {k: r.number(k) for k in WRENCH_FIELDS if k in values}
+
+
+def _calibration(path: Path,
+                 values: Mapping[str, Any]) -> dict[tuple[str, str], tuple[float, float]]:
+    r = _Reader(path, "calibration", values)
+    parts: dict[tuple[str, str], dict[str, float]] = {}
+    for key in values:
+        topic, _, rest = key.rpartition(".")
+        topic, _, fld = topic.rpartition(".")
+        if rest not in ("gain", "offset") or not topic or not fld:
+            raise r.fail(key, "expected '<topic>.<field>.gain' or '<topic>.<field>.offset'")
+        parts.setdefault((topic, fld), {})[rest] = r.number(key)
+    out = {}
+    for (topic, fld), p in parts.items():
+        gain = p.get("gain", 1.0)
+        if gain == 0:
+            raise r.fail(f"{topic}.{fld}.gain", "a gain of 0 would erase the channel")
+        out[(topic, fld)] = (gain, p.get("offset", 0.0))
+    return out
+
+
+def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
+                   needs_suspension: bool = True) -> tuple[RunMetadata, list[Problem]]:
+    """Typed metadata from raw records; raises IngestError on missing or contradictory values."""
+    path = Path(path)
+    records = {name: values for name, values in records.items() if values}  # {} = absent
+    problems: list[Problem] = []
+    for name in ("run", "wheel"):
+        if name not in records:
+            raise IngestError(path, f"swt.{name}", "metadata record missing")
+    for name, known in (("run", _RUN_KEYS), ("wheel", _WHEEL_KEYS),
+                        ("suspension", _SUSPENSION_KEYS), ("camera", _CAMERA_KEYS),
+                        ("camera_track", {"px_per_m"})):
+        problems += _unknown_keys(name, records.get(name, {}), known)
+    problems += [Problem("warning", f"swt.{n}", "unknown metadata record, ignored")
+                 for n in sorted(set(records) - set(RECORDS))]
+    suspension = None
+    if "suspension" in records:
+        r = _Reader(path, "suspension", records["suspension"])
+        suspension = SuspensionInfo(arm_length_m=r.positive("arm_length_m"),
+                                    angle_zero_rad=r.number("angle_zero_rad"))
+    elif needs_suspension:
+        raise IngestError(path, "swt.suspension",
+                          "metadata record missing; hub height needs arm_length_m and "
+                          "angle_zero_rad")
+    camera_track = None
+    if "camera_track" in records:
+        camera_track = CameraTrackInfo(
+            px_per_m=_Reader(path, "camera_track", records["camera_track"]).positive("px_per_m"))
+    metadata = RunMetadata(
+        run=_run_info(path, records["run"]), wheel=_wheel_info(path, records["wheel"]),
+        suspension=suspension,
+        camera=_camera_info(path, records["camera"]) if "camera" in records else None,
+        camera_track=camera_track,
+        zero=_zero(path, records.get("zero", {})),
+        calibration=_calibration(path, records.get("calibration", {})))
+    return metadata, problems

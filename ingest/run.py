@@ -1,0 +1,271 @@
+"""``read_run``: a run's files -> ``Run`` (typed metadata, SI streams, one channel table)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ingest import derive
+from ingest.calibration import subtract_zero, to_canonical
+from ingest.canonical import CANONICAL, DERIVED, MEASURED, SUBSTITUTES, WRENCH_COLUMNS
+from ingest.channel_map import ChannelMap, load_channel_map
+from ingest.checks import check_topic
+from ingest.csv_reader import read_csv_run
+from ingest.delimited_reader import read_delimited
+from ingest.errors import IngestError, Problem
+from ingest.mcap_reader import read_mcap
+from ingest.metadata import RunMetadata, parse_metadata
+from ingest.raw import FrameIndex, RawRun
+from ingest.records import merged_records
+from ingest.timebase import (DROP_FACTOR, GAP_FACTOR, JITTER_LIMIT, StreamTiming, common_grid,
+                             grid_mask, stream_timing, to_grid)
+
+_ZERO_OF = {column: fld for fld, column in WRENCH_COLUMNS.items()}
+#: longest plausible run; longer spans mean a stream is on another clock
+MAX_RUN_S = 6 * 3600.0
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run as ingest sees it.
+
+    ``streams``: per source topic, native ``t_s`` + canonical SI columns.
+    ``channels``: one table on the uniform ``t_s`` grid with every canonical and
+    derived column (NaN where a channel is missing or inside a gap).
+    """
+
+    source: Path
+    metadata: RunMetadata
+    streams: dict[str, pd.DataFrame]
+    channels: pd.DataFrame
+    problems: list[Problem]
+    derivation: dict
+    frames: dict[str, FrameIndex] = field(default_factory=dict)
+    timing: dict[str, StreamTiming] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+    channel_map: str = "spec"
+
+    @property
+    def run_id(self) -> str:
+        return self.metadata.run.run_id
+
+
+def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> Run:
+    """Read one run: a ``.mcap`` file, a CSV run folder, or a file a channel map describes."""
+    path = Path(path)
+    cmap = load_channel_map(channel_map)
+    raw = _read_raw(path, cmap)
+    for topic, data in raw.topics.items():
+        check_topic(path, topic, data)
+    problems = _coverage_problems(path, raw, cmap)
+    provided = {c.column for c in cmap.channels
+                if c.topic in raw.topics and c.field in raw.topics[c.topic].fields}
+    records = merged_records(path, raw.records, cmap)
+    metadata, meta_problems = parse_metadata(path, records,
+                                             needs_suspension="suspension_angle_rad" in provided)
+    problems += meta_problems
+    streams, units = _streams(raw, cmap, metadata, problems)
+    timing = {topic: stream_timing(frame["t_s"].to_numpy()) for topic, frame in streams.items()}
+    _check_clocks(path, timing)
+    problems += _timing_problems(timing)
+    channels, derivation = _channel_table(streams, timing, metadata, provided, problems)
+    problems += _frame_problems(raw.frames, metadata)
+    return Run(source=path, metadata=metadata, streams=streams, channels=channels,
+               problems=problems, derivation=derivation, frames=raw.frames, timing=timing,
+               units=units, channel_map=cmap.name)
+
+
+def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:
+    if not path.exists():
+        raise IngestError(path, None, "no such file or folder")
+    if cmap.format == "delimited":
+        if not path.is_file():
+            raise IngestError(path, None, f"channel map {cmap.name} reads one text file per run")
+        return read_delimited(path, cmap)
+    if path.is_file() and path.suffix.lower() == ".mcap":
+        return read_mcap(path, set(cmap.topics))
+    if path.is_dir() and (path / "run.json").is_file():
+        return read_csv_run(path, cmap)
+    raise IngestError(path, None, "not a run: expected a .mcap file or a folder holding run.json "
+                      "(for other files pass a channel map, e.g. "
+                      "--channel-map cmu_3d_terramechanics)")
+
+
+def _coverage_problems(path: Path, raw: RawRun, cmap: ChannelMap) -> list[Problem]:
+    """Missing required channels raise; missing optional or unmapped canonical ones are problems."""
+    problems = []
+    mapped = {c.column for c in cmap.channels}
+    for spec in cmap.channels:
+        topic = raw.topics.get(spec.topic)
+        if topic is not None and spec.field in topic.fields:
+            continue
+        where = f"{spec.topic}.{spec.field}"
+        why = "topic absent" if topic is None else f"field {spec.field!r} absent from the topic"
+        if spec.required:
+            raise IngestError(path, where, f"required channel missing ({why}); it feeds "
+                              f"{spec.column}")
+        problems.append(Problem("warning", spec.column, f"optional channel {where} absent ({why})"))
+    for column, required in MEASURED.items():
+        if column in mapped or not required:
+            continue
+        if any(s in mapped for s in SUBSTITUTES.get(column, ())):
+            continue
+        problems.append(Problem("error", column, f"not in this source (channel map "
+                                f"{cmap.name} has no channel for it); column is NaN"))
+    return problems
+
+
+def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
+             problems: list[Problem]) -> tuple[dict[str, pd.DataFrame], dict[str, str]]:
+    """Per topic: native t_s + calibrated, zeroed canonical SI columns."""
+    streams, units = {}, {}
+    used = set()
+    for topic in cmap.topics:
+        data = raw.topics.get(topic)
+        if data is None:
+            continue
+        columns = {"t_s": data.t_s}
+        for spec in cmap.channels_of(topic):
+            if spec.field not in data.fields:
+                continue
+            cal = metadata.calibration.get((topic, spec.field))
+            used.add((topic, spec.field))
+            values = to_canonical(data.fields[spec.field], spec, cal)
+            if spec.column in _ZERO_OF:
+                values = subtract_zero(values, metadata.zero.get(_ZERO_OF[spec.column]))
+            columns[spec.column] = values
+            units[spec.column] = spec.unit if cal is None else "SI (swt.calibration)"
+        streams[topic] = pd.DataFrame(columns)
+    for topic, fld in sorted(set(metadata.calibration) - used):
+        problems.append(Problem("warning", f"{topic}.{fld}",
+                                "swt.calibration names a channel this run does not have"))
+    return streams, units
+
+
+def _check_clocks(path: Path, timing: dict[str, StreamTiming]) -> None:
+    """All streams must count from the run start: a run longer than MAX_RUN_S is a clock error."""
+    start = min(s.t0_s for s in timing.values())
+    for topic, s in timing.items():
+        if s.t1_s - start > MAX_RUN_S:
+            raise IngestError(path, topic, f"time stamps reach {s.t1_s - start:.6g} s after the "
+                              f"run start (over {MAX_RUN_S / 3600:g} h): t_ns must count from "
+                              "the run start; is this stream on another clock?")
+
+
+def _timing_problems(timing: dict[str, StreamTiming]) -> list[Problem]:
+    problems = []
+    for topic, s in timing.items():
+        if s.n < 2:
+            problems.append(Problem("warning", topic, "only one sample; no rate, no interpolation"))
+            continue
+        if s.gaps:
+            total = sum(b - a for a, b in s.gaps)
+            first = s.gaps[0]
+            problems.append(Problem("warning", topic, f"{len(s.gaps)} gap(s) longer than "
+                                    f"{GAP_FACTOR:g} sample intervals, {total:.3f} s in all, first "
+                                    f"{first[0]:.3f}-{first[1]:.3f} s; NaN there on the time base"))
+        if s.dropped:
+            problems.append(Problem("warning", topic, f"about {s.dropped} dropped samples "
+                                    f"(intervals {DROP_FACTOR:g}-{GAP_FACTOR:g}x the median)"))
+        if s.jitter > JITTER_LIMIT:
+            problems.append(Problem("warning", topic, f"irregular clock: interval std is "
+                                    f"{100 * s.jitter:.0f}% of the median interval"))
+    return problems
+
+
+def _channel_table(streams, timing, metadata: RunMetadata, provided: set[str],
+                   problems: list[Problem]) -> tuple[pd.DataFrame, dict]:
+    """Every stream onto one uniform grid, then the derived signals on it."""
+    grid, rate = common_grid(list(timing.values()))
+    table: dict[str, np.ndarray] = {"t_s": grid}
+    for topic, frame in streams.items():
+        t = frame["t_s"].to_numpy()
+        mask = grid_mask(t, timing[topic], grid)
+        for column in frame.columns[1:]:
+            table[column] = to_grid(t, frame[column].to_numpy(), grid, mask)
+    derivation: dict = {"time_base": {
+        "rate_hz": rate, "t0_s": float(grid[0]), "samples": len(grid),
+        "method": "uniform grid at the fastest stream's median rate (capped at 1000 Hz); "
+                  "linear interpolation; NaN outside a stream's span and inside its gaps",
+        "gap_factor": GAP_FACTOR}}
+    _derive_rates(table, streams, rate, metadata, provided, derivation)
+    _derive_heights(table, metadata, provided, derivation, problems)
+    for column in CANONICAL + DERIVED:
+        table.setdefault(column, np.full(len(grid), np.nan))
+    order = ["t_s", *CANONICAL, *(c for c in DERIVED if c not in CANONICAL)]
+    order += sorted(set(table) - set(order))  # extra columns a channel map adds
+    return pd.DataFrame({c: table[c] for c in order}), derivation
+
+
+def _derive_rates(table, streams, rate, metadata, provided, derivation) -> None:
+    radius = metadata.wheel.radius_m
+    for position, rate_column in (("wheel_angle_rad", "wheel_omega_radps"),
+                                  ("sled_position_m", "sled_velocity_mps")):
+        if rate_column in provided:
+            derivation[rate_column] = {"method": "direct from source (channel map)"}
+            continue
+        if position not in provided:
+            continue
+        frame = next(f for f in streams.values() if position in f.columns)
+        stats = derive.encoder_noise(frame["t_s"].to_numpy(), frame[position].to_numpy())
+        window_s = derive.choose_window_s(stats)
+        table[rate_column], window = derive.savgol_derivative(table[position], rate, window_s)
+        derivation[rate_column] = {
+            "method": "savitzky_golay_derivative", "of": position, "polyorder": derive.POLYORDER,
+            "window_s": window / rate, "window_samples": window,
+            "target_relative_error": derive.TARGET_REL_ERROR, **stats}
+    if "wheel_surface_speed_mps" in provided and "wheel_omega_radps" not in table:
+        table["wheel_omega_radps"] = table["wheel_surface_speed_mps"] / radius
+        derivation["wheel_omega_radps"] = {"method": "wheel_surface_speed_mps / radius_m"}
+    elif "wheel_omega_radps" in table and "wheel_surface_speed_mps" not in provided:
+        table["wheel_surface_speed_mps"] = radius * table["wheel_omega_radps"]
+        derivation["wheel_surface_speed_mps"] = {"method": "radius_m * wheel_omega_radps",
+                                                 "radius_m": radius}
+    if "wheel_surface_speed_mps" in table and "sled_velocity_mps" in table:
+        eps = derive.slip_eps(metadata.run.velocity_mps, table["wheel_surface_speed_mps"],
+                              table["sled_velocity_mps"])
+        table["slip"] = derive.slip(table["wheel_surface_speed_mps"],
+                                    table["sled_velocity_mps"], eps)
+        derivation["slip"] = {"method": "spec: (r*omega - v)/(r*omega) driving, "
+                                        "(r*omega - v)/v skid (r*omega < v)",
+                              "nan_below_mps": eps,
+                              "nan_rule": "max(r*omega, v) <= nan_below_mps"}
+
+
+def _derive_heights(table, metadata, provided, derivation, problems) -> None:
+    if "suspension_angle_rad" in provided:
+        s = metadata.suspension
+        table["hub_height_m"] = derive.hub_height_m(table["suspension_angle_rad"],
+                                                    s.arm_length_m, s.angle_zero_rad)
+        derivation["hub_height_m"] = {"method": "spec: arm_length_m*(sin(angle)"
+                                                "-sin(angle_zero_rad))",
+                                      "arm_length_m": s.arm_length_m,
+                                      "angle_zero_rad": s.angle_zero_rad}
+    elif "hub_height_m" in provided:
+        derivation["hub_height_m"] = {"method": "direct from source (channel map)"}
+    else:
+        return
+    stiffness = metadata.wheel.stiffness_n_per_mm
+    fz = table.get("fz_n")
+    if stiffness is not None and fz is None:
+        problems.append(Problem("warning", "sinkage_m", "flexible wheel but no fz_n: sinkage "
+                                "cannot remove the wheel's own deflection; column is NaN"))
+    table["sinkage_m"] = derive.sinkage_m(table["hub_height_m"], fz, stiffness)
+    derivation["sinkage_m"] = (
+        {"method": "spec rigid: -hub_height_m"} if stiffness is None else
+        {"method": "spec flexible: -hub_height_m - fz_n/(1000*stiffness_N_per_mm)",
+         "stiffness_n_per_mm": stiffness})
+
+
+def _frame_problems(frames: dict[str, FrameIndex], metadata: RunMetadata) -> list[Problem]:
+    problems = []
+    if "/camera/side" in frames and metadata.camera is None:
+        problems.append(Problem("warning", "/camera/side", "frames without swt.camera metadata "
+                                "(px_per_m): soil flow cannot be scaled"))
+    if "/camera/track" in frames and metadata.camera_track is None:
+        problems.append(Problem("warning", "/camera/track", "photos without swt.camera_track "
+                                "metadata (px_per_m)"))
+    return problems
