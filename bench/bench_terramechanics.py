@@ -3,19 +3,18 @@
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 
 from terramechanics import EFFECTS, load_model
+from terramechanics.model_file import SHIPPED_MODELS
 
-MODEL = "examples/models/bb2_sand.toml"
+MODEL = SHIPPED_MODELS / "bb2_sand.toml"
 GOAL_S = 0.5
 
 
 def main(quick: bool = False) -> dict:
-    path = Path(__file__).resolve().parent.parent / MODEL
-    model = load_model(path).with_effects(**{name: True for name in EFFECTS})
+    model = load_model(MODEL).with_effects(**{name: True for name in EFFECTS})
     loads = np.array([70.0, 180.0, 300.0])[:, None]
     slips = np.linspace(-0.5, 0.9, 50)[None, :]
     repeats = 3 if quick else 10

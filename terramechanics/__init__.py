@@ -9,7 +9,8 @@ from terramechanics.conversions import (drucker_prager_to_mohr_coulomb,
                                         mohr_coulomb_to_drucker_prager)
 from terramechanics.effects import EFFECTS, Effect, make_effect
 from terramechanics.model import WheelModel
-from terramechanics.model_file import load_model, model_from_dict, model_to_dict, save_model
+from terramechanics.model_file import (load_model, model_from_dict, model_to_dict, save_model,
+                                       shipped_model)
 from terramechanics.soil import LETE_SAND, LUNAR_NOMINAL, SOILS, WONG_DRY_SAND, SoilParams
 from terramechanics.state import EARTH_GRAVITY_MPS2
 from terramechanics.testbed_law import ModelLaw
@@ -19,5 +20,5 @@ __all__ = [
     "EARTH_GRAVITY_MPS2", "EFFECTS", "Effect", "LETE_SAND", "LUNAR_NOMINAL", "ModelLaw", "SOILS",
     "SoilParams", "WONG_DRY_SAND", "Wheel", "WheelModel", "drucker_prager_to_mohr_coulomb",
     "load_model", "make_effect", "model_from_dict", "model_to_dict",
-    "mohr_coulomb_to_drucker_prager", "save_model",
+    "mohr_coulomb_to_drucker_prager", "save_model", "shipped_model",
 ]

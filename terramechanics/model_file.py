@@ -12,6 +12,8 @@ from terramechanics.soil import SOILS, SoilParams
 from terramechanics.state import EARTH_GRAVITY_MPS2
 from terramechanics.wheel import Wheel
 
+SHIPPED_MODELS = Path(__file__).parent / "models"
+
 
 class ModelFileError(ValueError):
     """A model file that cannot be used; the message names the table and key."""
@@ -64,6 +66,15 @@ def load_model(path: str | Path) -> WheelModel:
     except tomllib.TOMLDecodeError as exc:
         raise ModelFileError(f"{path}: not valid TOML: {exc}") from None
     return model_from_dict(data)
+
+
+def shipped_model(name: str) -> WheelModel:
+    """A model file shipped with swtlab (``terramechanics/models/<name>.toml``)."""
+    path = SHIPPED_MODELS / f"{name}.toml"
+    if not path.exists():
+        known = sorted(p.stem for p in SHIPPED_MODELS.glob("*.toml"))
+        raise ModelFileError(f"no shipped model {name!r}; shipped: {known}")
+    return load_model(path)
 
 
 def model_to_dict(model: WheelModel) -> dict:

@@ -12,15 +12,15 @@ from __future__ import annotations
 
 import re
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from terramechanics import EFFECTS, LETE_SAND, Wheel, WheelModel, load_model
 from terramechanics.effects import Bulldozing, Grousers, make_effect
+from terramechanics.model_file import SHIPPED_MODELS
 
-BB2_FILE = Path(__file__).resolve().parents[1] / "examples" / "models" / "bb2_sand.toml"
+BB2_FILE = SHIPPED_MODELS / "bb2_sand.toml"
 SLIPS = np.linspace(0.0, 0.9, 19)
 
 

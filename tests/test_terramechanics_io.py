@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -13,9 +12,9 @@ from swtlab_cli import exit_codes
 from swtlab_cli.main import main as swtlab
 from terramechanics import (LUNAR_NOMINAL, drucker_prager_to_mohr_coulomb, load_model,
                             mohr_coulomb_to_drucker_prager, save_model)
-from terramechanics.model_file import ModelFileError
+from terramechanics.model_file import SHIPPED_MODELS, ModelFileError
 
-BB2_FILE = Path(__file__).resolve().parents[1] / "examples" / "models" / "bb2_sand.toml"
+BB2_FILE = SHIPPED_MODELS / "bb2_sand.toml"
 
 
 def test_mohr_coulomb_drucker_prager_values_and_round_trip():

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from virtual_testbed.conditions import RunCondition
-from virtual_testbed.law import PerformanceLaw, PlaceholderLaw
+from virtual_testbed.law import PerformanceLaw, bb2_sand_law
 from virtual_testbed.measure import RawRun, measure
 from virtual_testbed.rig import BB2_WHEEL, Suspension, Timeline, Wheel
 from virtual_testbed.sensors import Rates, SensorModel
@@ -28,7 +28,7 @@ FORMS = ("mcap", "csv")
 class Testbed:
     """Everything fixed across a campaign: the law, the rig, the sensors and the run timeline."""
 
-    law: PerformanceLaw = field(default_factory=PlaceholderLaw)
+    law: PerformanceLaw = field(default_factory=bb2_sand_law)
     wheel: Wheel = BB2_WHEEL
     suspension: Suspension = Suspension()
     timeline: Timeline = Timeline()

@@ -18,9 +18,10 @@ class Wheel:
     mass_kg: float | None = None
 
 
-#: ExoMars BB2-like rigid wheel (radius 125 mm without grousers, 12 grousers of 9.2 mm).
+#: ExoMars BB2-like flexible wheel (radius 125 mm without grousers, 12 grousers of 9.2 mm);
+#: its radial stiffness is the one of terramechanics/models/bb2_sand.toml (30 kN/m).
 BB2_WHEEL = Wheel(name="BB2-like", radius_m=0.125, width_m=0.112, grouser_count=12,
-                  grouser_height_m=0.0092)
+                  grouser_height_m=0.0092, stiffness_n_per_mm=30.0)
 
 
 @dataclass(frozen=True)

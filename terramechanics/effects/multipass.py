@@ -8,7 +8,7 @@ J. Terramech. 49). Linear in the pass index ``i`` (0 = virgin soil):
 ``kc, kphi -> (1 + a_k i) kc, kphi`` and ``rho -> (1 + a_rho i) rho``. The default
 ``a_k`` reproduces the ExoMars BB2 single-wheel multipass numbers quoted in the
 swtlab issue (resistance at 180 N: about 18 N on virgin soil, about 15 N at
-multipass 2) with examples/models/bb2_sand.toml.
+multipass 2) with terramechanics/models/bb2_sand.toml.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ performance. Niksirat, Daca & Skonieczny (2020) "The effects of reduced-gravity 
 planetary rover mobility", Int. J. Robotics Research 39(7):797-811, measured in
 parabolic flights at the same wheel load about 20 % less traction at lunar gravity,
 5-10 % at Martian gravity, with more sinkage. With Reece's law (alpha = 1) the
-Wong-Reece model of a BB2-like wheel (examples/models/bb2_sand.toml) loses 21 % of
+Wong-Reece model of a BB2-like wheel (terramechanics/models/bb2_sand.toml) loses 21 % of
 its peak drawbar pull at lunar and 10 % at Martian gravity, with 2-3 times the
 sinkage; ``alpha`` is the handle to fit flight data. The unit weight in the grouser
 and bulldozing terms also becomes rho g. Without this effect gravity enters only through the load.
