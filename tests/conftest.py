@@ -213,3 +213,31 @@ def ingest_tools():
                            truth_topics=ingest_truth_topics, records=ingest_records,
                            Spec=IngestMcapSpec, write_mcap=ingest_write_mcap,
                            write_csv_run=ingest_write_csv_run)
+
+
+# --- databases: every database test runs on SQLite, and on PostgreSQL where .ci/run started one
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def db_url(request, tmp_path):
+    """A fresh, empty database URL: a SQLite file, or a new PostgreSQL database (dropped after)."""
+    if request.param == "sqlite":
+        yield f"sqlite:///{tmp_path / 'swtlab.sqlite'}"
+        return
+    import os
+    import uuid
+
+    from sqlalchemy import create_engine, text
+    from sqlalchemy.engine import make_url
+
+    admin_url = os.environ.get("SWTLAB_TEST_POSTGRES_URL")
+    if not admin_url:
+        pytest.skip("no PostgreSQL server (set SWTLAB_TEST_POSTGRES_URL; .ci/run starts one)")
+    name = f"swtlab_test_{uuid.uuid4().hex[:12]}"
+    admin = create_engine(admin_url, isolation_level="AUTOCOMMIT")
+    with admin.connect() as connection:
+        connection.execute(text(f'CREATE DATABASE "{name}"'))
+    yield make_url(admin_url).set(database=name).render_as_string(hide_password=False)
+    with admin.connect() as connection:
+        connection.execute(text(f'DROP DATABASE "{name}" WITH (FORCE)'))
+    admin.dispose()

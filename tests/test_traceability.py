@@ -11,7 +11,7 @@ from sqlalchemy import func, inspect, select
 import ingest
 from ingest.inspect_report import report
 from swtlab_cli.main import main
-from traceability import open_database, sqlite_url, store_ingested_run
+from traceability import open_database, store_ingested_run
 from traceability.database import upgrade
 from traceability.models import Calibration, ProcessingRecord, RawFile, Run, TestCondition
 from traceability.store import StoreOutcome
@@ -38,12 +38,12 @@ def _count(factory, model) -> int:
         return session.scalar(select(func.count()).select_from(model))
 
 
-def test_unchanged_file_changes_nothing_and_changed_file_gets_new_version(tmp_path):
+def test_unchanged_file_changes_nothing_and_changed_file_gets_new_version(tmp_path, db_url):
     csv_run = tmp_path / "run_csv"
     shutil.copytree(_some_runs("csv", 1)[0], csv_run)
     mcap_run = tmp_path / "run.mcap"
     shutil.copy(_some_runs("mcap", 1)[0], mcap_run)
-    factory = open_database(sqlite_url(tmp_path / "db.sqlite"))
+    factory = open_database(db_url)
 
     assert _store(factory, csv_run) is StoreOutcome.NEW_RUN
     assert _store(factory, mcap_run) is StoreOutcome.NEW_RUN
@@ -69,10 +69,10 @@ def test_unchanged_file_changes_nothing_and_changed_file_gets_new_version(tmp_pa
         assert session.scalar(select(func.count()).select_from(Run)) == 2
 
 
-def test_conditions_and_calibrations_are_recorded(tmp_path):
+def test_conditions_and_calibrations_are_recorded(db_url):
     path = _some_runs("mcap", 1)[0]
     run = ingest.read_run(path)
-    factory = open_database(sqlite_url(tmp_path / "db.sqlite"))
+    factory = open_database(db_url)
     _store(factory, path)
     with factory() as session:
         condition = session.scalars(select(TestCondition)).one()
@@ -88,14 +88,14 @@ def test_conditions_and_calibrations_are_recorded(tmp_path):
         assert session.scalars(select(ProcessingRecord)).one().swtlab_version
 
 
-def test_migrations_go_up_and_down(tmp_path):
+def test_migrations_go_up_and_down(db_url):
     from alembic import command
     from alembic.config import Config
     from sqlalchemy import create_engine
 
     from traceability.database import MIGRATIONS
 
-    engine = create_engine(sqlite_url(tmp_path / "db.sqlite"))
+    engine = create_engine(db_url)
     upgrade(engine)
     assert {"raw_file", "run", "test_condition", "calibration"} <= set(
         inspect(engine).get_table_names())
@@ -107,7 +107,7 @@ def test_migrations_go_up_and_down(tmp_path):
     assert set(inspect(engine).get_table_names()) == {"alembic_version"}
 
 
-def test_batch_goes_on_past_bad_runs(tmp_path, capsys):
+def test_batch_goes_on_past_bad_runs(tmp_path, capsys, db_url):
     campaign = tmp_path / "campaign"
     campaign.mkdir()
     good = _some_runs("mcap", 2)
@@ -115,7 +115,7 @@ def test_batch_goes_on_past_bad_runs(tmp_path, capsys):
         shutil.copy(path, campaign / path.name)
     corrupt = campaign / "corrupt.mcap"
     corrupt.write_bytes(good[0].read_bytes()[: good[0].stat().st_size // 2])
-    db = sqlite_url(tmp_path / "db.sqlite")
+    db = db_url
 
     assert main(["ingest", str(campaign), "--db", db, "--quiet"]) == 0
     out = capsys.readouterr().out

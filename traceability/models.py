@@ -127,3 +127,75 @@ class Calibration(Base):
     offset: Mapped[float] = mapped_column(Float)
 
     raw_file: Mapped[RawFile] = relationship(back_populates="calibrations")
+
+
+class IngestFailure(Base):
+    """A file that could not be read, with the one-line reason (kept so a batch report can list it)."""
+
+    __tablename__ = "ingest_failure"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    path: Mapped[str] = mapped_column(String(1000))
+    sha256: Mapped[str] = mapped_column(String(64))
+    error: Mapped[str] = mapped_column(String(2000))
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+
+class StableWindow(Base):
+    """The stable phase found in one raw-file version: where, how, and the checks it passed."""
+
+    __tablename__ = "stable_window"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    raw_file_id: Mapped[int] = mapped_column(ForeignKey("raw_file.id"))
+    found: Mapped[bool] = mapped_column()
+    start_s: Mapped[float | None] = mapped_column(Float, nullable=True)
+    end_s: Mapped[float | None] = mapped_column(Float, nullable=True)
+    method: Mapped[str] = mapped_column(String(200))
+    parameters: Mapped[dict] = mapped_column(JSON)
+    diagnostics: Mapped[dict] = mapped_column(JSON)
+    reason: Mapped[str | None] = mapped_column(String(1000), nullable=True)
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+
+class RunResult(Base):
+    """Results of one raw-file version under one set of processing parameters.
+
+    ``params_sha256`` hashes the processing parameters and swtlab version: the same
+    file processed the same way is stored once; other parameters add a row.
+    """
+
+    __tablename__ = "run_result"
+    __table_args__ = (UniqueConstraint("raw_file_id", "params_sha256"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    raw_file_id: Mapped[int] = mapped_column(ForeignKey("raw_file.id"))
+    stable_window_id: Mapped[int] = mapped_column(ForeignKey("stable_window.id"))
+    params_sha256: Mapped[str] = mapped_column(String(64))
+    status: Mapped[str] = mapped_column(String(20))
+    flags: Mapped[list] = mapped_column(JSON)
+    oscillation: Mapped[dict] = mapped_column(JSON)
+    corrections: Mapped[dict] = mapped_column(JSON)
+    dp_trace: Mapped[dict | None] = mapped_column(JSON, nullable=True)
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    raw_file: Mapped[RawFile] = relationship()
+    window: Mapped[StableWindow] = relationship()
+    processing: Mapped[ProcessingRecord] = relationship()
+    quantities: Mapped[list[RunQuantity]] = relationship(back_populates="result",
+                                                         order_by="RunQuantity.id")
+
+
+class RunQuantity(Base):
+    """One quantity of a run result: mean, standard deviation, autocorrelation-corrected SE."""
+
+    __tablename__ = "run_quantity"
+    __table_args__ = (UniqueConstraint("run_result_id", "quantity"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    run_result_id: Mapped[int] = mapped_column(ForeignKey("run_result.id"))
+    quantity: Mapped[str] = mapped_column(String(60))
+    unit: Mapped[str] = mapped_column(String(20))
+    mean: Mapped[float | None] = mapped_column(Float, nullable=True)
+    std: Mapped[float | None] = mapped_column(Float, nullable=True)
+    se: Mapped[float | None] = mapped_column(Float, nullable=True)
+    n: Mapped[int] = mapped_column(Integer)
+    n_eff: Mapped[float | None] = mapped_column(Float, nullable=True)
+
+    result: Mapped[RunResult] = relationship(back_populates="quantities")
