@@ -22,8 +22,9 @@ $(STAMP): pyproject.toml | system-deps
 
 demo: $(STAMP)
 	mkdir -p $(OUT)
-	$(BIN)/swtlab ingest sample_data/campaign --db sqlite:///$(OUT)/swtlab.sqlite
-	@echo "results: $(OUT)/swtlab.sqlite (SQLite; try: $(BIN)/swtlab inspect <run>)"
+	$(BIN)/swtlab process sample_data/campaign --db sqlite:///$(OUT)/swtlab.sqlite
+	$(BIN)/swtlab results --db sqlite:///$(OUT)/swtlab.sqlite --csv $(OUT)/results.csv
+	@echo "results: database $(OUT)/swtlab.sqlite, one row per run in $(OUT)/results.csv"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -12,7 +12,7 @@ import sys
 
 from swtlab_cli import exit_codes
 
-SUBCOMMANDS = ["inspect", "ingest", "sim"]
+SUBCOMMANDS = ["inspect", "process", "results", "export", "wpm", "sim", "track_slip"]
 
 
 def _version() -> str:

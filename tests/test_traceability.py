@@ -13,7 +13,8 @@ from ingest.inspect_report import report
 from swtlab_cli.main import main
 from traceability import open_database, store_ingested_run
 from traceability.database import upgrade
-from traceability.models import Calibration, ProcessingRecord, RawFile, Run, TestCondition
+from traceability.models import (Calibration, IngestFailure, ProcessingRecord, RawFile, Run,
+                                 TestCondition)
 from traceability.store import StoreOutcome
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
@@ -117,13 +118,19 @@ def test_batch_goes_on_past_bad_runs(tmp_path, capsys, db_url):
     corrupt.write_bytes(good[0].read_bytes()[: good[0].stat().st_size // 2])
     db = db_url
 
-    assert main(["ingest", str(campaign), "--db", db, "--quiet"]) == 0
+    assert main(["process", str(campaign), "--db", db, "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "ingested 2 of 3 runs" in out and "1 failed" in out
+    assert "processed 2 of 3 runs" in out and "1 failed" in out
     assert "corrupt.mcap" in out
-    assert _count(open_database(db), RawFile) == 2
+    factory = open_database(db)
+    assert _count(factory, RawFile) == 2
+    assert _count(factory, IngestFailure) == 1
+    # the failure is listed again on the next call, but stored once
+    assert main(["process", str(campaign), "--db", db, "--quiet"]) == 0
+    assert "1 failed" in capsys.readouterr().out
+    assert _count(factory, IngestFailure) == 1
 
     only_bad = tmp_path / "only_bad"
     only_bad.mkdir()
     shutil.copy(corrupt, only_bad / corrupt.name)
-    assert main(["ingest", str(only_bad), "--db", db, "--quiet"]) == 3
+    assert main(["process", str(only_bad), "--db", db, "--quiet"]) == 3

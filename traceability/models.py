@@ -139,6 +139,8 @@ class IngestFailure(Base):
     error: Mapped[str] = mapped_column(String(2000))
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
 
+    processing: Mapped[ProcessingRecord] = relationship()
+
 
 class StableWindow(Base):
     """The stable phase found in one raw-file version: where, how, and the checks it passed."""
@@ -154,6 +156,8 @@ class StableWindow(Base):
     diagnostics: Mapped[dict] = mapped_column(JSON)
     reason: Mapped[str | None] = mapped_column(String(1000), nullable=True)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    processing: Mapped[ProcessingRecord] = relationship()
 
 
 class RunResult(Base):
@@ -199,3 +203,61 @@ class RunQuantity(Base):
     n_eff: Mapped[float | None] = mapped_column(Float, nullable=True)
 
     result: Mapped[RunResult] = relationship(back_populates="quantities")
+
+
+class CurveFit(Base):
+    """A fitted performance curve of one (wheel, soil, multipass, load) group and quantity.
+
+    ``fit_sha256`` hashes the fitted inputs, the fit options and the swtlab version: the
+    same fit is stored once and reused by every export that holds it.
+    """
+
+    __tablename__ = "curve_fit"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    fit_sha256: Mapped[str] = mapped_column(String(64), unique=True)
+    wheel: Mapped[str] = mapped_column(String(200))
+    soil: Mapped[str] = mapped_column(String(200))
+    multipass: Mapped[int] = mapped_column(Integer)
+    load_n: Mapped[float] = mapped_column(Float)
+    quantity: Mapped[str] = mapped_column(String(40))
+    unit: Mapped[str] = mapped_column(String(20))
+    degree: Mapped[int] = mapped_column(Integer)
+    coefficients: Mapped[list] = mapped_column(JSON)
+    slip_min: Mapped[float] = mapped_column(Float)
+    slip_max: Mapped[float] = mapped_column(Float)
+    n_points: Mapped[int] = mapped_column(Integer)
+    rmse: Mapped[float] = mapped_column(Float)
+    diagnostics: Mapped[dict] = mapped_column(JSON)
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    processing: Mapped[ProcessingRecord] = relationship()
+    inputs: Mapped[list[RunResult]] = relationship(secondary="curve_fit_input")
+
+
+class CurveFitInput(Base):
+    """Which run results a curve was fitted from."""
+
+    __tablename__ = "curve_fit_input"
+    curve_fit_id: Mapped[int] = mapped_column(ForeignKey("curve_fit.id"), primary_key=True)
+    run_result_id: Mapped[int] = mapped_column(ForeignKey("run_result.id"), primary_key=True)
+
+
+class WpmExport(Base):
+    """One WPM CSV written: where, its sha256, the sha256 of its fitted inputs, its curves."""
+
+    __tablename__ = "wpm_export"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    path: Mapped[str] = mapped_column(String(1000))
+    file_sha256: Mapped[str] = mapped_column(String(64))
+    inputs_sha256: Mapped[str] = mapped_column(String(64))
+    format_version: Mapped[str] = mapped_column(String(40))
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    processing: Mapped[ProcessingRecord] = relationship()
+    fits: Mapped[list[CurveFit]] = relationship(secondary="wpm_export_fit")
+
+
+class WpmExportFit(Base):
+    __tablename__ = "wpm_export_fit"
+    wpm_export_id: Mapped[int] = mapped_column(ForeignKey("wpm_export.id"), primary_key=True)
+    curve_fit_id: Mapped[int] = mapped_column(ForeignKey("curve_fit.id"), primary_key=True)

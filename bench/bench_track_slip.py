@@ -1,0 +1,90 @@
+"""Track-photo slip: accuracy over random renders (issue goal: |error| <= 0.5 pp for 95 %),
+refusals on mark-free images, and which radius the mark spacing follows."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from softflow.track_slip import NoPeriodicMarksError, measure_track_slip
+from virtual_testbed.track_render import mark_spacing_m, random_nuisance, render_track
+
+RADIUS_M, GROUSERS, HEIGHT_M = 0.125, 12, 0.0092  # BB2-like wheel
+SIZE_PX = (800, 600)
+
+
+def _accuracy(count: int) -> dict:
+    errors_pp, refused, seconds = [], 0, []
+    slips = np.linspace(0.0, 0.8, count)
+    for i, slip in enumerate(slips):
+        rng = np.random.default_rng(50_000 + i)
+        px_per_m = float(rng.uniform(600, 1100))
+        image, truth = render_track(float(slip), RADIUS_M, GROUSERS, HEIGHT_M, px_per_m, seed=i,
+                                    nuisance=random_nuisance(60_000 + i, SIZE_PX))
+        start = time.perf_counter()
+        try:
+            result = measure_track_slip(image, RADIUS_M, GROUSERS, px_per_m=px_per_m)
+            errors_pp.append(100 * abs(result.slip - truth["slip"]))
+        except NoPeriodicMarksError:
+            refused += 1
+            errors_pp.append(np.inf)
+        seconds.append(time.perf_counter() - start)
+    err = np.array(errors_pp)
+    measured = err[np.isfinite(err)]
+    out = {"renders": count, "refused": refused,
+           "within_0p5pp": float(np.mean(err <= 0.5)),
+           "median_abs_error_pp": float(np.median(err)),
+           "p95_abs_error_pp": float(np.percentile(err, 95)),
+           "max_abs_error_pp_measured": float(measured.max()),
+           "median_seconds": float(np.median(seconds))}
+    print(f"{'renders':>8}{'refused':>9}{'<=0.5pp':>9}{'median pp':>11}{'p95 pp':>8}"
+          f"{'max pp':>8}{'s/image':>9}")
+    print(f"{count:>8}{refused:>9}{out['within_0p5pp']:>9.1%}{out['median_abs_error_pp']:>11.3f}"
+          f"{out['p95_abs_error_pp']:>8.3f}{out['max_abs_error_pp_measured']:>8.3f}"
+          f"{out['median_seconds']:>9.2f}")
+    return out
+
+
+def _refusals(count: int) -> dict:
+    refused = 0
+    for i in range(count):
+        nuisance = random_nuisance(70_000 + i, SIZE_PX)
+        if i % 2:
+            nuisance = replace(nuisance, track_width_m=0.0, sinkage_m=0.0)
+        image, _ = render_track(0.3, seed=i, nuisance=replace(nuisance, marks=False))
+        try:
+            measure_track_slip(image, RADIUS_M, GROUSERS, px_per_m=900.0)
+        except NoPeriodicMarksError:
+            refused += 1
+    print(f"mark-free images (sand, tracks without marks): {refused} of {count} refused")
+    return {"mark_free_images": count, "mark_free_refused": refused}
+
+
+def _radius() -> list[dict]:
+    """Measured spacing against 2*pi*r*(1-s)/n with the rim radius and the tip radius."""
+    rows = []
+    print(f"{'h mm':>6}{'slip':>6}{'measured mm':>13}{'rim r mm':>10}{'tip r+h mm':>12}"
+          f"{'slip(r) %':>11}{'slip(r+h) %':>13}")
+    for height_m in (0.0092, 0.02, 0.03):
+        for slip in (0.1, 0.4, 0.7):
+            image, _ = render_track(slip, RADIUS_M, GROUSERS, height_m, 900.0, seed=1,
+                                    size_px=SIZE_PX, track_angle_deg=25.0)
+            rim = measure_track_slip(image, RADIUS_M, GROUSERS, px_per_m=900.0)
+            tip = measure_track_slip(image, RADIUS_M + height_m, GROUSERS, px_per_m=900.0)
+            row = {"grouser_height_m": height_m, "slip": slip, "measured_m": rim.spacing_m,
+                   "rim_m": mark_spacing_m(slip, RADIUS_M, GROUSERS),
+                   "tip_m": mark_spacing_m(slip, RADIUS_M + height_m, GROUSERS),
+                   "slip_with_rim": rim.slip, "slip_with_tip": tip.slip}
+            rows.append(row)
+            print(f"{1000 * height_m:>6.1f}{slip:>6.2f}{1000 * row['measured_m']:>13.2f}"
+                  f"{1000 * row['rim_m']:>10.2f}{1000 * row['tip_m']:>12.2f}"
+                  f"{100 * rim.slip:>11.2f}{100 * tip.slip:>13.2f}")
+    return rows
+
+
+def main(quick: bool = False) -> dict:
+    return {"accuracy": _accuracy(30 if quick else 200),
+            "refusals": _refusals(6 if quick else 40),
+            "radius": _radius()}

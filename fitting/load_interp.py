@@ -1,0 +1,150 @@
+"""The curve at any load from the curves at the tested loads.
+
+RUAG WPAT: "an interpolation for various wheel loads is also implemented allowing reducing
+the test campaign to the minimum, nominal and maximum load case only". Done on curve values,
+never on raw high-order coefficients: each tested curve is evaluated on a common slip grid
+(Chebyshev-Lobatto points on the slip range the loads share), the values are interpolated
+across load at each slip, and a polynomial is fitted to the interpolated values.
+
+Across load: ``"pchip"`` (monotone piecewise-cubic Hermite, Fritsch & Carlson 1980) with 3
+or more tested loads, ``"linear"`` otherwise (``"auto"`` picks so). Outside the tested loads
+only with ``allow_extrapolation=True``, then linearly from the two nearest loads, with a
+:class:`LoadExtrapolationWarning`.
+"""
+
+from __future__ import annotations
+
+import functools
+import warnings
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from numpy.polynomial import chebyshev
+from scipy.interpolate import PchipInterpolator
+
+from fitting.curve import DEGREES, PowerCurve
+from fitting.errors import DegreeError, LoadExtrapolationWarning, LoadRangeError
+from fitting.polynomial import horner, lobatto_grid, power_matrix, scaled_slip
+
+GRID_POINTS = 101
+METHODS = ("auto", "linear", "pchip")
+
+
+@dataclass(frozen=True)
+class InterpolatedCurve(PowerCurve):
+    """The curve at ``load_n``; ``fit_rmse`` is the RMS misfit of its polynomial to the
+    interpolated grid values (0 to rounding for linear interpolation: a weighted sum of
+    polynomials is one)."""
+
+    load_n: float
+    method: str
+    tested_loads_n: tuple[float, ...]
+    extrapolated: bool
+    fit_rmse: float
+
+    def to_dict(self) -> dict:
+        return {**asdict(self), "coefficients": list(self.coefficients), "degree": self.degree}
+
+
+@dataclass(frozen=True)
+class LoadCurves:
+    """Curves at many loads at once: row ``i`` of ``coefficients`` is the curve at
+    ``loads_n[i]``; all share [slip_min, slip_max]."""
+
+    loads_n: np.ndarray
+    coefficients: np.ndarray
+    slip_min: float
+    slip_max: float
+    method: str
+    tested_loads_n: tuple[float, ...]
+    extrapolated: np.ndarray
+    fit_rmse: np.ndarray
+
+    def curve(self, i: int) -> InterpolatedCurve:
+        return InterpolatedCurve(
+            coefficients=tuple(float(a) for a in self.coefficients[i]), slip_min=self.slip_min,
+            slip_max=self.slip_max, load_n=float(self.loads_n[i]), method=self.method,
+            tested_loads_n=self.tested_loads_n, extrapolated=bool(self.extrapolated[i]),
+            fit_rmse=float(self.fit_rmse[i]))
+
+
+def _check_loads(tested: np.ndarray, query: np.ndarray, allow_extrapolation: bool) -> np.ndarray:
+    """Mask of queries outside the tested loads; raise where that is not allowed."""
+    if tested.size == 0:
+        raise LoadRangeError("no tested loads to interpolate from")
+    if not np.all(np.isfinite(query)) or np.any(query <= 0):
+        raise LoadRangeError(f"loads must be finite and > 0 N, got {query[~(query > 0)][:3]}")
+    outside = (query < tested[0]) | (query > tested[-1])
+    span = f"{tested[0]:g}-{tested[-1]:g} N" if tested.size > 1 else f"{tested[0]:g} N only"
+    if np.any(outside):
+        bad = query[outside][0]
+        if tested.size < 2:
+            raise LoadRangeError(f"load {bad:g} N: one tested load ({span}), nothing to "
+                                 "interpolate from")
+        if not allow_extrapolation:
+            raise LoadRangeError(f"load {bad:g} N outside the tested loads ({span}); pass "
+                                 "allow_extrapolation to extrapolate linearly from the two "
+                                 "nearest loads")
+        warnings.warn(f"{int(outside.sum())} load(s) outside the tested loads ({span}), e.g. "
+                      f"{bad:g} N: extrapolated linearly", LoadExtrapolationWarning, stacklevel=3)
+    return outside
+
+
+def _across_load(tested: np.ndarray, values: np.ndarray, query: np.ndarray,
+                 method: str, outside: np.ndarray) -> np.ndarray:
+    """Grid values (tested loads x slips) interpolated to the query loads (queries x slips)."""
+    if tested.size == 1:
+        return np.repeat(values, query.size, axis=0)
+    hi = np.clip(np.searchsorted(tested, query), 1, tested.size - 1)
+    t = ((query - tested[hi - 1]) / (tested[hi] - tested[hi - 1]))[:, None]
+    out = (1.0 - t) * values[hi - 1] + t * values[hi]  # linear, also the extrapolation
+    if method == "pchip" and np.any(~outside):
+        out[~outside] = PchipInterpolator(tested, values, axis=0)(query[~outside])
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _projection(slip_min: float, slip_max: float, degree: int,
+                grid_points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Slip grid and the matrix taking values on it to the power coefficients of their
+    least-squares polynomial (fitted in the Chebyshev basis)."""
+    grid = lobatto_grid(slip_min, slip_max, grid_points)
+    design = chebyshev.chebvander(scaled_slip(grid, slip_min, slip_max), degree)
+    return grid, np.linalg.pinv(design).T @ power_matrix(slip_min, slip_max, degree).T
+
+
+def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: str = "auto",
+                      degree: int | None = None, allow_extrapolation: bool = False,
+                      grid_points: int = GRID_POINTS) -> LoadCurves:
+    """Curves at every load of ``loads_n`` from ``curves`` (tested load in N -> curve of one
+    quantity). ``degree``: of the fitted result, default the highest tested degree.
+    Raises :class:`LoadRangeError` (load outside the tested ones without
+    ``allow_extrapolation``, no common slip range) or :class:`DegreeError`."""
+    if method not in METHODS:
+        raise ValueError(f"method {method!r}: one of {METHODS}")
+    tested = np.array(sorted(float(k) for k in curves))
+    query = np.atleast_1d(np.asarray(loads_n, dtype=float)).ravel()
+    outside = _check_loads(tested, query, allow_extrapolation)
+    ordered = [curves[k] for k in sorted(curves, key=float)]
+    lo, hi = max(c.slip_min for c in ordered), min(c.slip_max for c in ordered)
+    if lo >= hi:
+        raise LoadRangeError(f"the tested loads {tested.tolist()} share no slip range")
+    degree = max(c.degree for c in ordered) if degree is None else degree
+    if degree not in DEGREES:
+        raise DegreeError(f"degree {degree!r} outside 3-7")
+    method = ("pchip" if tested.size >= 3 else "linear") if method == "auto" else method
+    grid, projection = _projection(lo, hi, degree, grid_points)
+    values = _across_load(tested, np.array([horner(c.coefficients, grid) for c in ordered]),
+                          query, method, outside)
+    coefficients = values @ projection
+    misfit = horner(coefficients[:, None, :], grid) - values
+    return LoadCurves(loads_n=query, coefficients=coefficients, slip_min=lo, slip_max=hi,
+                      method=method, tested_loads_n=tuple(tested.tolist()), extrapolated=outside,
+                      fit_rmse=np.sqrt(np.mean(misfit ** 2, axis=1)))
+
+
+def interpolate_load(curves: Mapping[float, PowerCurve], load_n: float,
+                     **options) -> InterpolatedCurve:
+    """The curve at one load; options as :func:`interpolate_loads`."""
+    return interpolate_loads(curves, [load_n], **options).curve(0)

@@ -1,0 +1,16 @@
+"""Per-run results with honest uncertainty, for every test mode (docs/run-results.md).
+
+Pure functions: ``process_run(run) -> RunResult``; ``towed_vs_powered(results)``. Never
+reads ground truth.
+"""
+
+from run_results.corrections import RigCompliance, corrected_heights, tare_record
+from run_results.modes import towed_vs_powered
+from run_results.oscillation import harmonic_fit, measure_frequency_hz, waveform_peaks
+from run_results.process import process_run
+from run_results.result import RunResult
+from run_results.stats import QuantityStats, quantity_stats
+
+__all__ = ["QuantityStats", "RigCompliance", "RunResult", "corrected_heights", "harmonic_fit",
+           "measure_frequency_hz", "process_run", "quantity_stats", "tare_record",
+           "towed_vs_powered", "waveform_peaks"]

@@ -1,0 +1,147 @@
+"""``process_run``: a run -> stable window -> corrected channels -> ``RunResult``.
+
+Quantities over the window (keys match the virtual testbed's truth where they overlap):
+slip, travel velocity, wheel angular velocity, wheel load ``fz``, drawbar pull, input
+torque ``ty``, thrust ``H = T/r``, motion resistance ``R = T/r - DP`` (Wong, Theory of
+Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correction; for
+steered runs also the side force ``fy`` and the slip angle (logged channel, else the
+set steering angle).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from run_results import oscillation as osc
+from run_results.corrections import RigCompliance, corrected_heights, tare_record
+from run_results.result import RunResult
+from run_results.stats import quantity_stats
+from stable_phase import StablePhaseParams, detect_stable_phase
+from stable_phase.signals import decimate_mean
+
+FORCE_CHANNELS = ("fx_n", "fy_n", "fz_n", "tx_nm", "ty_nm", "tz_nm", "dp_n")
+#: a measured passing frequency this far from n*omega/2pi is flagged
+GROUSER_MISMATCH_RATIO = 0.05
+DP_TRACE_POINTS = 500
+
+
+def _condition(run) -> dict:
+    info = run.metadata.run
+    return {"campaign": info.campaign, "wheel": info.wheel, "soil": info.soil,
+            "multipass": info.multipass, "load_n": info.load_n,
+            "slip_setpoint": info.slip_setpoint, "velocity_mps": info.velocity_mps,
+            "steer_deg": info.steer_deg, "gravity_mps2": info.gravity_mps2}
+
+
+def _series(run, rig: RigCompliance | None) -> tuple[dict[str, tuple[np.ndarray, str]], dict]:
+    """Every quantity's per-sample series (after corrections) with its unit."""
+    ch, meta = run.channels, run.metadata
+    radius = meta.wheel.radius_m
+    fz = ch["fz_n"].to_numpy()
+    fz_for_rig = np.where(np.isfinite(fz), fz, meta.run.load_n)
+    hub, sinkage, correction = corrected_heights(ch["hub_height_m"].to_numpy(), fz_for_rig,
+                                                 meta.wheel.stiffness_n_per_mm, rig)
+    if rig is None:
+        sinkage = ch["sinkage_m"].to_numpy()
+    torque = ch["ty_nm"].to_numpy()
+    dp = ch["dp_n"].to_numpy()
+    series = {
+        "slip": (ch["slip"].to_numpy(), "1"),
+        "travel_velocity_mps": (ch["sled_velocity_mps"].to_numpy(), "m/s"),
+        "wheel_omega_radps": (ch["wheel_omega_radps"].to_numpy(), "rad/s"),
+        "wheel_load_n": (fz, "N"),
+        "dp_n": (dp, "N"),
+        "torque_nm": (torque, "N*m"),
+        "thrust_n": (torque / radius, "N"),
+        "resistance_n": (torque / radius - dp, "N"),
+        "sinkage_m": (sinkage, "m"),
+        "hub_height_m": (hub, "m"),
+    }
+    if meta.run.mode == "steered":
+        series["side_force_n"] = (ch["fy_n"].to_numpy(), "N")
+        if "slip_angle_rad" in ch and np.isfinite(ch["slip_angle_rad"].to_numpy()).any():
+            series["slip_angle_deg"] = (np.degrees(ch["slip_angle_rad"].to_numpy()), "deg")
+        else:
+            series["slip_angle_deg"] = (np.full(len(ch), float(meta.run.steer_deg)), "deg")
+    return series, {"correction_m": correction}
+
+
+def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
+    """Passing frequency measured in the forces against ``n omega/2pi``; waveform peaks."""
+    n = run.metadata.wheel.grouser_count
+    omega = float(np.nanmean(series["wheel_omega_radps"][0][lo:hi]))
+    out = {"grouser_expected_hz": n * abs(omega) / (2.0 * np.pi) if n > 0 else None,
+           "grouser_measured_hz": None, "grouser_signal": None}
+    candidates = [k for k in ("dp_n", "torque_nm", "wheel_load_n")
+                  if np.isfinite(series[k][0][lo:hi]).mean() > 0.5
+                  and not (k == "dp_n" and run.metadata.run.mode == "free_sled")]
+    if n > 0 and candidates:
+        signal = candidates[0]
+        out["grouser_signal"] = signal
+        out["grouser_measured_hz"] = osc.measure_frequency_hz(
+            t[lo:hi], series[signal][0][lo:hi], out["grouser_expected_hz"])
+    frequency = out["grouser_measured_hz"] or out["grouser_expected_hz"]
+    for key, name, unit in (("dp_n", "dp", "n"), ("torque_nm", "torque", "nm")):
+        y = series[key][0][lo:hi]
+        if frequency and np.isfinite(y).mean() > 0.5 and key in candidates:
+            peaks = osc.waveform_peaks(t[lo:hi], y, frequency)
+            out[f"{name}_peak_{unit}"] = peaks["peak"]
+            out[f"{name}_peak_to_peak_{unit}"] = peaks["peak_to_peak"]
+        else:
+            out[f"{name}_peak_{unit}"] = out[f"{name}_peak_to_peak_{unit}"] = None
+    out["method"] = ("Hann zero-padded FFT peak within +-40 % of n*omega/2pi, refined by "
+                     f"least squares on a {osc.HARMONICS}-harmonic series; peaks from the "
+                     "fitted waveform")
+    return out, frequency
+
+
+def _flags(run, window, oscillation: dict) -> list[str]:
+    flags = []
+    missing = [c for c in FORCE_CHANNELS if not np.isfinite(run.channels[c].to_numpy()).any()]
+    if missing:
+        flags.append(f"no force channels ({', '.join(missing)}): forces, torque, thrust and "
+                     "resistance not reported; window found from speeds and hub height alone")
+    if window.diagnostics.get("shrunk_to_second_half"):
+        flags.append("window shrunk to its second half: the first half drifted (slope test)")
+    if window.found and not window.diagnostics.get("r_hat_ok", True):
+        flags.append(f"split-window R statistic {window.diagnostics['r_hat_max']:.3f} above "
+                     f"{window.parameters['r_hat_limit']}")
+    expected, measured = oscillation["grouser_expected_hz"], oscillation["grouser_measured_hz"]
+    if expected and measured and abs(measured / expected - 1.0) > GROUSER_MISMATCH_RATIO:
+        flags.append(f"grouser passing frequency {measured:.4g} Hz differs from n*omega/2pi = "
+                     f"{expected:.4g} Hz by more than {100 * GROUSER_MISMATCH_RATIO:g} %")
+    return flags
+
+
+def process_run(run, params: StablePhaseParams | None = None,
+                rig: RigCompliance | None = None) -> RunResult:
+    """Stable window, corrected quantities with honest SE, oscillation and flags of one run."""
+    window = detect_stable_phase(run, params)
+    series, applied = _series(run, rig)
+    t = run.channels["t_s"].to_numpy()
+    corrections = {"tare": tare_record(run),
+                   "rig_compliance": None if rig is None else rig.to_dict()}
+    common = {"run_id": run.run_id, "mode": run.metadata.run.mode, "window": window,
+              "condition": _condition(run)}
+    if not window.found:
+        tb, dpb = decimate_mean(t, run.channels["dp_n"].to_numpy(), DP_TRACE_POINTS)
+        trace = {"t_s": tb.tolist(), "dp_n": [None if not np.isfinite(v) else float(v)
+                                              for v in dpb]}
+        flags = (f"no stable phase: {window.reason}", *_flags(run, window, {
+            "grouser_expected_hz": None, "grouser_measured_hz": None}))
+        return RunResult(status="no_stable_phase", flags=flags, quantities={}, oscillation={},
+                         dp_trace=trace, corrections=corrections, **common)
+    lo, hi = int(np.searchsorted(t, window.start_s)), int(np.searchsorted(t, window.end_s)) + 1
+    oscillation, frequency = _oscillation(run, t, lo, hi, series)
+    quantities = {}
+    for key, (y, unit) in series.items():
+        periodic = None
+        if frequency and np.isfinite(y[lo:hi]).sum() > 16:
+            periodic = osc.harmonic_fit(t[lo:hi], y[lo:hi], frequency)["periodic"]
+        stats = quantity_stats(y[lo:hi], unit, periodic)
+        if stats is not None:
+            quantities[key] = stats
+    corrections["hub_height_correction_mean_m"] = float(np.nanmean(applied["correction_m"][lo:hi]))
+    flags = tuple(_flags(run, window, oscillation))
+    return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,
+                     oscillation=oscillation, dp_trace=None, corrections=corrections, **common)

@@ -1,0 +1,52 @@
+"""``RunResult``: one run's stable-phase results, flags, oscillation and corrections."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from run_results.stats import QuantityStats
+from stable_phase import StableWindow
+
+STATUSES = ("ok", "flagged", "no_stable_phase")
+
+
+def _json_number(value):
+    """NaN/inf become None so the dict is strict JSON."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _json_number(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_number(v) for v in value]
+    return value
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Per-run results (see docs/run-results.md). ``condition``: wheel, soil, multipass,
+    set load, set slip, steering angle and velocity, for grouping runs across a campaign."""
+
+    run_id: str
+    mode: str
+    status: str
+    flags: tuple[str, ...]
+    window: StableWindow
+    quantities: dict[str, QuantityStats]
+    oscillation: dict
+    dp_trace: dict | None
+    corrections: dict
+    condition: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise ValueError(f"status {self.status!r} not in {STATUSES}")
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict (NaN as null)."""
+        return _json_number({
+            "run_id": self.run_id, "mode": self.mode, "status": self.status,
+            "flags": list(self.flags), "window": self.window.to_dict(),
+            "quantities": {k: v.to_dict() for k, v in self.quantities.items()},
+            "oscillation": dict(self.oscillation), "dp_trace": self.dp_trace,
+            "corrections": dict(self.corrections), "condition": dict(self.condition)})

@@ -1,0 +1,47 @@
+"""``swtlab results --db URL [--csv FILE | --json]``: one row per run (columns in docs/results.md)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from swtlab_cli import exit_codes
+
+SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
+                   "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
+                   "torque_nm_mean", "sinkage_m_mean", "resistance_n_mean"]
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser(
+        "results", help="list the results of every run in the database",
+        description="One row per run: identifiers and conditions, status and flags, the stable "
+                    "window, and each quantity's mean, standard deviation and standard error in "
+                    "SI units (columns: docs/results.md). Without --csv/--json, a summary table.")
+    parser.add_argument("--db", required=True, help="SQLAlchemy URL")
+    out = parser.add_mutually_exclusive_group()
+    out.add_argument("--csv", type=Path, help="write every column to this CSV file")
+    out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from traceability import open_database
+    from traceability.queries import latest_results
+
+    with open_database(args.db)() as session:
+        table = latest_results(session)
+    if table.empty:
+        print(f"swtlab results: {args.db}: no processed runs (run swtlab process first)",
+              file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    if args.csv:
+        table.to_csv(args.csv, index=False)
+        print(f"{len(table)} runs written to {args.csv}")
+    elif args.json:
+        print(table.to_json(orient="records", indent=1))
+    else:
+        columns = [c for c in SUMMARY_COLUMNS if c in table.columns]
+        print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    return exit_codes.OK

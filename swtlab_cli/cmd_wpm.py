@@ -1,0 +1,136 @@
+"""``swtlab wpm query WPM.csv --load N (--dp X | --torque X | --sinkage X | --resistance X |
+--slip S)``: answers of the Wheel Performance Module from a WPM CSV (docs/wpm-csv.md)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import sys
+import warnings
+
+from swtlab_cli import exit_codes
+from wpm_export.schema import UNITS
+
+#: option -> quantity of the inverse query
+TARGETS = {"dp": "dp_n", "torque": "torque_nm", "sinkage": "sinkage_m",
+           "resistance": "resistance_n"}
+
+
+def finite(text: str) -> float:
+    """A finite number from the command line."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "wpm", help="Wheel Performance Module queries on a WPM CSV (docs/wpm-csv.md)",
+        description="Answers from a WPM CSV, after RUAG's Wheel Performance Module.")
+    sub = p.add_subparsers(dest="wpm_command", metavar="WPM_COMMAND", required=True)
+    q = sub.add_parser(
+        "query", help="slip for a required DP/torque/sinkage/resistance, or values at a slip",
+        description="With --dp/--torque/--sinkage/--resistance: the smallest slip at which the "
+                    "wheel gives that value at the load (slip 1.0 and the maximum when it "
+                    "cannot). With --slip: every quantity at that slip. Loads between the "
+                    "tested ones are interpolated across load on curve values.")
+    q._negative_number_matcher = re.compile(r"^-\d*\.?\d")
+    q.add_argument("wpm_csv", help="WPM CSV file")
+    q.add_argument("--load", type=finite, required=True, help="wheel load in N")
+    ask = q.add_mutually_exclusive_group(required=True)
+    ask.add_argument("--dp", type=finite, help="required drawbar pull in N")
+    ask.add_argument("--torque", type=finite, help="required torque in N*m")
+    ask.add_argument("--sinkage", type=finite, help="required sinkage in m")
+    ask.add_argument("--resistance", type=finite, help="required motion resistance in N")
+    ask.add_argument("--slip", type=finite, help="slip (fraction, driving (r*w - v)/(r*w))")
+    q.add_argument("--soil", help="soil of the curves (needed when the file has several)")
+    q.add_argument("--wheel", help="wheel of the curves (needed when the file has several)")
+    q.add_argument("--multipass", type=int, help="multipass index of the curves")
+    q.add_argument("--allow-extrapolation", action="store_true",
+                   help="answer for a load outside the tested loads (linear, with a warning)")
+    q.add_argument("--json", action="store_true", help="one JSON object on standard output")
+    q.set_defaults(func=run_query)
+
+
+def _inverse(wpm, args, chosen: dict) -> dict:
+    option = next(o for o in TARGETS if getattr(args, o) is not None)
+    quantity, target = TARGETS[option], getattr(args, option)
+    extrapolate = {"allow_extrapolation": args.allow_extrapolation}
+    found = wpm.slip_for(quantity, target, args.load, **chosen, **extrapolate)
+    curve = wpm.curve(quantity, args.load, **chosen, **extrapolate)
+    slip = float(found.slip)
+    return {"quantity": quantity, "unit": UNITS[quantity], "target": target,
+            "slip": slip if slip == slip else None,  # NaN (below the curve) -> null
+            "value": float(found.value), "status": str(found.status),
+            "slip_min": curve.slip_min, "slip_max": curve.slip_max, "method": curve.method,
+            "tested_loads_n": list(curve.tested_loads_n), "extrapolated_load": curve.extrapolated}
+
+
+def _values(wpm, args, chosen: dict) -> dict:
+    out = {"slip": args.slip, "values": {}, "units": {}, "outside_slip_range": {}}
+    for quantity in wpm.quantities(**chosen):
+        curve = wpm.curve(quantity, args.load, **chosen,
+                          allow_extrapolation=args.allow_extrapolation)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out["values"][quantity] = float(curve.evaluate(args.slip))
+        out["units"][quantity] = UNITS[quantity]
+        out["outside_slip_range"][quantity] = bool(curve.outside_range(args.slip))
+        out.update(method=curve.method, tested_loads_n=list(curve.tested_loads_n),
+                   extrapolated_load=curve.extrapolated)
+    return out
+
+
+def _print_text(answer: dict) -> None:
+    head = (f"{answer['soil']} / {answer['wheel']} / multipass {answer['multipass']} at "
+            f"{answer['load_n']:g} N ({answer['method']} across {answer['tested_loads_n']} N"
+            + (", EXTRAPOLATED in load" if answer["extrapolated_load"] else "") + ")")
+    print(head)
+    if "quantity" in answer:
+        q, u = answer["quantity"], answer["unit"]
+        if answer["status"] == "ok":
+            print(f"{q} = {answer['target']:g} {u} at slip {answer['slip']:.6g}")
+        elif answer["status"] == "above_max":
+            print(f"{q} = {answer['target']:g} {u} is beyond the wheel: slip 1.0 (100 %), "
+                  f"maximum achievable {answer['value']:.6g} {u}")
+        else:
+            print(f"{q} = {answer['target']:g} {u} is below the curve over slips "
+                  f"[{answer['slip_min']:g}, {answer['slip_max']:g}]: no slip; minimum "
+                  f"{answer['value']:.6g} {u}")
+        return
+    for q, v in answer["values"].items():
+        flag = "  (outside the fitted slip range: extrapolated)" \
+            if answer["outside_slip_range"][q] else ""
+        print(f"{q:13s} {v:.6g} {answer['units'][q]}{flag}")
+
+
+def run_query(args: argparse.Namespace) -> int:
+    from fitting.errors import FittingError
+    from wpm_export import WheelPerformanceModule, WpmFormatError, WpmSelectionError
+
+    try:
+        wpm = WheelPerformanceModule.load(args.wpm_csv)
+        soil, wheel, multipass = wpm.select(soil=args.soil, wheel=args.wheel,
+                                            multipass=args.multipass)
+        chosen = {"soil": soil, "wheel": wheel, "multipass": multipass}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            answer = (_values if args.slip is not None else _inverse)(wpm, args, chosen)
+    except (OSError, WpmFormatError, WpmSelectionError, FittingError) as exc:
+        print(f"swtlab wpm: {exc}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    for w in {str(w.message) for w in caught}:
+        print(f"swtlab wpm: warning: {w}", file=sys.stderr)
+    answer = {"file": args.wpm_csv, "soil": soil, "wheel": wheel, "multipass": multipass,
+              "load_n": args.load, **answer}
+    if args.json:
+        print(json.dumps(answer))
+    else:
+        _print_text(answer)
+    return exit_codes.OK

@@ -1,0 +1,109 @@
+"""swtlab process / results end to end: one row per run, and a batch killed midway finishes cleanly."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+from sqlalchemy import func, select
+
+from swtlab_cli.main import main
+from traceability import open_database
+from traceability.models import ProcessingRecord, RawFile, RunQuantity, RunResult, StableWindow
+
+SAMPLE = Path(__file__).resolve().parents[1] / "sample_data"
+QUANTITIES = ("slip", "travel_velocity_mps", "wheel_omega_radps", "wheel_load_n", "dp_n",
+              "torque_nm", "thrust_n", "resistance_n", "sinkage_m")
+
+
+def _small_campaign(tmp_path: Path, run_ids: list[str]) -> Path:
+    campaign = tmp_path / "campaign"
+    campaign.mkdir()
+    for run_id in run_ids:
+        source = SAMPLE / "campaign" / f"{run_id}.mcap"
+        if source.exists():
+            shutil.copy(source, campaign / source.name)
+        else:
+            shutil.copytree(SAMPLE / "campaign" / run_id, campaign / run_id)
+    return campaign
+
+
+def _counts(db_url: str) -> dict[str, int]:
+    with open_database(db_url)() as session:
+        return {model.__name__: session.scalar(select(func.count()).select_from(model))
+                for model in (RawFile, RunResult, StableWindow, RunQuantity, ProcessingRecord)}
+
+
+def test_results_table_has_one_row_per_run_with_the_truth(tmp_path, db_url, capsys):
+    run_ids = ["L180_MP0_SC_s+020", "L180_MP0_SC_s+090", "L180_MP0_TW"]
+    campaign = _small_campaign(tmp_path, run_ids)
+    assert main(["process", str(campaign), "--db", db_url, "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "processed 3 of 3 runs" in out and "without a stable phase" in out
+    assert main(["results", "--db", db_url, "--json"]) == 0
+    table = pd.DataFrame(json.loads(capsys.readouterr().out)).set_index("run_id")
+    assert sorted(table.index) == sorted(run_ids)
+    for q in QUANTITIES:
+        assert {f"{q}_mean", f"{q}_std", f"{q}_se"} <= set(table.columns)
+    assert table.loc["L180_MP0_SC_s+090", "status"] == "no_stable_phase"
+    assert "digs in" in table.loc["L180_MP0_SC_s+090", "no_window_reason"]
+    for run_id in ("L180_MP0_SC_s+020", "L180_MP0_TW"):
+        truth = json.loads((SAMPLE / "truth" / f"{run_id}.json").read_text())
+        row, means = table.loc[run_id], truth["stable_means"]
+        assert row["status"] == "ok"
+        assert abs(row["window_start_s"] - truth["stable_window"]["start_s"]) < 2.0
+        assert abs(row["dp_n_mean"] - means["dp_n"]) < max(0.01 * abs(means["dp_n"]),
+                                                          3 * row["dp_n_se"]) + 0.5
+        assert abs(row["slip_mean"] - means["slip"]) < 2e-3
+    csv_path = tmp_path / "results.csv"
+    assert main(["results", "--db", db_url, "--csv", str(csv_path)]) == 0
+    assert len(pd.read_csv(csv_path)) == 3
+
+
+def test_reprocessing_changes_nothing(tmp_path, db_url):
+    campaign = _small_campaign(tmp_path, ["L070_MP0_SC_s+010", "L070_MP0_FS"])
+    assert main(["process", str(campaign), "--db", db_url, "--quiet"]) == 0
+    before = _counts(db_url)
+    assert main(["process", str(campaign), "--db", db_url, "--quiet"]) == 0
+    assert _counts(db_url) == before
+
+
+def test_killed_batch_finishes_on_rerun_without_duplicates(tmp_path):
+    """SIGKILL mid-batch, run again: every run once, nothing lost (each run is one transaction)."""
+    run_ids = sorted(p.stem for p in (SAMPLE / "campaign").glob("L300_*.mcap"))
+    campaign = _small_campaign(tmp_path, run_ids)
+    db_url = f"sqlite:///{tmp_path / 'swtlab.sqlite'}"
+    command = [sys.executable, "-m", "swtlab_cli.main", "process", str(campaign), "--db", db_url,
+               "--quiet"]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    deadline = time.monotonic() + 120
+    stored = 0
+    while time.monotonic() < deadline and process.poll() is None:
+        time.sleep(0.2)
+        try:
+            stored = _counts(db_url)["RunResult"]
+        except Exception:  # noqa: BLE001 - the schema may not exist yet
+            continue
+        if stored >= 3:
+            process.send_signal(signal.SIGKILL)
+            break
+    process.wait(timeout=60)
+    assert process.returncode == -signal.SIGKILL, "the batch ended before it could be killed"
+    assert 3 <= stored < len(run_ids)
+    kept = _counts(db_url)
+    assert kept["RunResult"] >= stored
+    assert main(["process", str(campaign), "--db", db_url, "--quiet"]) == 0
+    after = _counts(db_url)
+    assert after["RunResult"] == after["RawFile"] == len(run_ids)
+    assert after["StableWindow"] == len(run_ids)
+    with open_database(db_url)() as session:
+        paths = session.scalars(select(RawFile.path)).all()
+    assert len(set(paths)) == len(paths) == len(run_ids)

@@ -1,0 +1,91 @@
+"""Building blocks of stable-phase detection on signals whose answers are known."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stable_phase.autocorr import standard_error, statistical_inefficiency
+from stable_phase.checks import slope_test, split_r_hat
+from stable_phase.gate import bridge_dropouts, surface_speed_setpoint_mps
+from stable_phase.mser import mser_two_sided
+from stable_phase.settling import fit_settling
+from stable_phase.signals import grouser_period_s, longest_true_run, moving_average
+
+
+def ar1(phi: float, n: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    e = rng.normal(size=n)
+    x = np.empty(n)
+    x[0] = e[0] / np.sqrt(1 - phi**2)
+    # AR(1) by an IIR filter (no loop per sample)
+    from scipy.signal import lfilter
+    x = lfilter([1.0], [1.0, -phi], e)
+    return x
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.5, 0.9])
+def test_statistical_inefficiency_of_ar1(phi):
+    """AR(1): g = (1 + phi)/(1 - phi) (Sokal 1997)."""
+    g = np.mean([statistical_inefficiency(ar1(phi, 20000, s)) for s in range(5)])
+    assert g == pytest.approx((1 + phi) / (1 - phi), rel=0.12)
+
+
+def test_standard_error_is_honest_for_ar1():
+    z = []
+    for seed in range(200):
+        x = ar1(0.8, 2000, seed)
+        se, std, n, n_eff = standard_error(x)
+        z.append(np.mean(x) / se)
+        assert n == 2000 and n_eff < n / 5
+    assert 0.8 < np.std(z) < 1.25
+
+
+def test_moving_average_full_only_and_nan():
+    x = np.arange(10.0)
+    x[4] = np.nan
+    m = moving_average(x, 3, full_only=True)
+    assert np.isnan(m[0]) and np.isnan(m[-1])
+    assert m[1] == 1.0 and m[4] == 4.0 and m[5] == 5.5
+
+
+def test_longest_run_and_bridging():
+    mask = np.array([0, 1, 1, 0, 1, 1, 1, 0, 0, 0, 1], bool)
+    assert longest_true_run(mask) == (4, 7)
+    assert longest_true_run(bridge_dropouts(mask, 1)) == (1, 7)
+    assert longest_true_run(np.zeros(3, bool)) is None
+
+
+def test_mser_cuts_a_transient_and_an_end_effect():
+    rng = np.random.default_rng(0)
+    y = rng.normal(0, 0.1, 100)
+    y[:15] += np.linspace(3, 0.3, 15)
+    y[-5:] -= 2.0
+    d1, d2, _ = mser_two_sided(y, 0.5)
+    assert 12 <= d1 <= 17 and d2 == 5
+
+
+def test_settling_fit_recovers_onset_and_time_constant():
+    t = np.linspace(0, 60, 2401)
+    y = 4.0 - 1.5 * np.exp(-np.clip(t - 3.0, 0, None) / 5.0)
+    fit = fit_settling(t, y + np.random.default_rng(1).normal(0, 0.002, t.size))
+    assert fit["tau_s"] == pytest.approx(5.0, rel=0.03)
+    assert fit["onset_s"] == pytest.approx(3.0, abs=0.3) and fit["snr"] > 100
+
+
+def test_slope_test_and_r_hat():
+    t = np.linspace(0, 30, 1200)
+    rng = np.random.default_rng(2)
+    flat = rng.normal(0, 1, t.size)
+    ramp = flat + 0.2 * t
+    assert slope_test(t, flat)["p"] > 0.01 and split_r_hat(flat) < 1.05
+    test = slope_test(t, ramp)
+    assert test["p"] < 1e-6 and test["change"] == pytest.approx(6.0, rel=0.1)
+    assert split_r_hat(ramp) > 1.5
+
+
+def test_set_points_and_grouser_period():
+    assert surface_speed_setpoint_mps(0.01, 0.5) == pytest.approx(0.02)
+    assert surface_speed_setpoint_mps(0.01, -0.5) == pytest.approx(0.005)
+    assert grouser_period_s(12, 2 * np.pi / 12) == pytest.approx(1.0)
+    assert grouser_period_s(0, 1.0) is None

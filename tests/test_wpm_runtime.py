@@ -1,0 +1,136 @@
+"""The WPM runtime (RUAG WPM): curve at a load, quantities at a slip, and the slip for a
+required DP/torque/sinkage/resistance -- checked against dense brute force, with 100 % slip
+and the maximum for unreachable targets, vectorised, and clear errors on ambiguous input."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from fitting import LoadExtrapolationWarning, LoadRangeError, OutsideSlipRangeWarning, fit_results
+from wpm_export import (WheelPerformanceModule, WpmCurve, WpmSelectionError, inputs_sha256,
+                        read_wpm_csv, solve_slip, write_wpm_csv)
+from test_fitting_synthetic import MODEL, model_results_table
+
+
+@pytest.fixture(scope="module")
+def wpm(tmp_path_factory):
+    table = model_results_table(multipass=(0, 1), seed=7)
+    path = tmp_path_factory.mktemp("wpm") / "wpm.csv"
+    write_wpm_csv(fit_results(table), path, inputs_sha256(table), "test")
+    return WheelPerformanceModule.load(path)
+
+
+def _brute_force(curve, target):
+    """Smallest slip on a 2e6-point grid where the curve reaches the target."""
+    s = np.linspace(curve.slip_min, curve.slip_max, 2_000_001)
+    v = curve.evaluate(s)
+    hit = (v[:-1] - target) * (v[1:] - target) <= 0
+    return s[np.argmax(hit)] if hit.any() else None
+
+
+@pytest.mark.parametrize("quantity, targets", [
+    ("dp_n", [-25.0, 0.0, 10.0, 25.0, 45.0]),
+    ("torque_nm", [0.0, 2.0, 6.0, 9.0]),
+    ("sinkage_m", [0.0035, 0.004, 0.006]),
+    ("resistance_n", [13.0, 16.0, 20.0]),
+])
+def test_inverse_matches_dense_brute_force(wpm, quantity, targets):
+    found = wpm.slip_for(quantity, targets, 120.0, multipass=0)
+    curve = wpm.curve(quantity, 120.0, multipass=0)
+    for target, slip, status in zip(targets, found.slip, found.status):
+        expected = _brute_force(curve, target)
+        assert status == "ok" and expected is not None
+        assert slip == pytest.approx(expected, abs=1e-6)
+    np.testing.assert_allclose(found.value, targets, rtol=0, atol=1e-9)
+
+
+def test_the_smallest_slip_is_returned_when_a_peaked_curve_reaches_the_target_twice():
+    peaked = WpmCurve((0.0, 100.0, -100.0, 0.0), 0.0, 1.0, soil="s", wheel="w", multipass=0,
+                      load_n=100.0, quantity="dp_n", unit="N", n_points=8, rmse=0.0, line=3)
+    found = solve_slip(np.array([peaked.coefficients]), [0, 0], [16.0, 25.0], 0.0, 1.0)
+    assert found.slip[0] == pytest.approx(0.2, abs=1e-12)  # 100 s - 100 s^2 = 16: 0.2 and 0.8
+    assert found.slip[1] == pytest.approx(0.5, abs=1e-7) and found.status[1] == "ok"
+
+
+def test_unreachable_dp_gives_100_percent_slip_and_the_maximum(wpm):
+    curve = wpm.curve("dp_n", 120.0, multipass=0)
+    s = np.linspace(curve.slip_min, curve.slip_max, 2_000_001)
+    peak = curve.evaluate(s).max()
+    found = wpm.slip_for("dp_n", [peak + 0.01, 500.0], 120.0, multipass=0)
+    assert found.slip.tolist() == [1.0, 1.0]
+    assert found.status.tolist() == ["above_max", "above_max"]
+    np.testing.assert_allclose(found.value, peak, rtol=1e-10)
+    assert not found.reached.any()
+
+
+def test_a_target_below_the_curve_has_no_slip(wpm):
+    found = wpm.slip_for("dp_n", -500.0, 120.0, multipass=0)
+    assert np.isnan(found.slip) and str(found.status) == "below_min"
+    curve = wpm.curve("dp_n", 120.0, multipass=0)
+    assert float(found.value) == pytest.approx(curve.evaluate(curve.slip_min), rel=1e-9)
+
+
+def test_queries_are_vectorised_over_targets_and_loads(wpm):
+    rng = np.random.default_rng(0)
+    targets = rng.uniform(-10, 40, (4, 50))
+    loads = rng.uniform(70, 300, (4, 1))
+    found = wpm.slip_for("dp_n", targets, loads, multipass=1)
+    assert found.slip.shape == found.value.shape == found.status.shape == (4, 50)
+    for i in (0, 3):
+        for j in (0, 17, 49):
+            one = wpm.slip_for("dp_n", targets[i, j], loads[i, 0], multipass=1)
+            assert float(one.slip) == pytest.approx(found.slip[i, j], abs=1e-12)
+    ok = found.reached
+    assert ok.mean() > 0.9
+    np.testing.assert_allclose(found.value[ok], targets[ok], atol=1e-9)
+
+
+def test_at_slip_gives_every_quantity(wpm):
+    values = wpm.at_slip([0.0, 0.3], 180.0, multipass=0)
+    assert list(values) == ["dp_n", "torque_nm", "sinkage_m", "resistance_n", "dp_over_w"]
+    for q, v in values.items():
+        np.testing.assert_allclose(v, wpm.curve(q, 180.0, multipass=0).evaluate([0.0, 0.3]))
+    truth = MODEL.curves(180.0, 0.3, 0)
+    assert values["dp_n"][1] == pytest.approx(truth["dp_n"], abs=1.0)  # 56.9 N
+    assert values["sinkage_m"][1] == pytest.approx(truth["sinkage_m"], abs=2e-4)
+    assert values["dp_over_w"][1] == pytest.approx(values["dp_n"][1] / 180.0, rel=0.03)
+    with pytest.warns(OutsideSlipRangeWarning, match=r"slip outside the range of dp_n "
+                                                     r"\[-0.1, 0.6\], torque_nm"):
+        wpm.at_slip(0.8, 180.0, multipass=0)
+
+
+def test_the_curve_at_a_load_is_interpolated_on_values(wpm):
+    curve = wpm.curve("dp_n", 120.0, multipass=0)
+    assert curve.method == "pchip" and curve.tested_loads_n == (70.0, 180.0, 300.0)
+    assert (curve.slip_min, curve.slip_max) == (-0.1, 0.6)
+    assert curve.evaluate(0.2) == pytest.approx(MODEL.curves(120.0, 0.2, 0)["dp_n"], abs=1.0)
+
+
+def test_several_curve_sets_need_a_choice(wpm):
+    assert wpm.sets() == [("bb2_sand", "bb2", 0), ("bb2_sand", "bb2", 1)]
+    with pytest.raises(WpmSelectionError, match="2 curve sets match .*pick one: --soil bb2_sand "
+                                                "--wheel bb2 --multipass 0; --soil bb2_sand"):
+        wpm.slip_for("dp_n", 25.0, 120.0)
+    with pytest.raises(WpmSelectionError, match="no curves for soil=clay"):
+        wpm.curve("dp_n", 120.0, soil="clay")
+    _, rows = read_wpm_csv(wpm.source)
+    one_quantity = WheelPerformanceModule([c for c in rows if c.quantity == "dp_n"
+                                           and c.multipass == 0])
+    with pytest.raises(WpmSelectionError, match="no torque_nm curves .* it has dp_n"):
+        one_quantity.slip_for("torque_nm", 2.0, 120.0)
+
+
+def test_loads_that_do_not_bracket_the_request(wpm):
+    with pytest.raises(LoadRangeError, match="load 400 N outside the tested loads"):
+        wpm.slip_for("dp_n", 25.0, 400.0, multipass=0)
+    with pytest.raises(LoadRangeError, match="load 20 N outside"):
+        wpm.at_slip(0.2, [100.0, 20.0], multipass=0)
+    with pytest.warns(LoadExtrapolationWarning):
+        found = wpm.slip_for("dp_n", 25.0, 400.0, multipass=0, allow_extrapolation=True)
+    assert found.status == "ok"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        wpm.slip_for("dp_n", 25.0, 300.0, multipass=0)  # a tested load: silent

@@ -1,0 +1,60 @@
+"""Read-back: one row per run with its conditions, stable window and results (``swtlab results``)."""
+
+from __future__ import annotations
+
+import pandas as pd
+from sqlalchemy import func, select
+from sqlalchemy.orm import Session
+
+from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult, Soil,
+                                 StableWindow, TestCondition, Wheel)
+
+STATS = ("mean", "std", "se")
+
+
+def latest_results(session: Session) -> pd.DataFrame:
+    """Newest result of the newest raw-file version of every run, one row per run.
+
+    Columns are documented in docs/results.md: identifiers, conditions, status and
+    flags, the stable window, ``<quantity>_mean|_std|_se`` per quantity, and the
+    grouser oscillation.
+    """
+    newest_file = (select(RawFile.run_pk, func.max(RawFile.version).label("version"))
+                   .group_by(RawFile.run_pk).subquery())
+    newest_result = (select(RunResult.raw_file_id, func.max(RunResult.id).label("result_id"))
+                     .group_by(RunResult.raw_file_id).subquery())
+    rows = session.execute(
+        select(Campaign.name, Run.run_id, RawFile.version, RawFile.path, RawFile.sha256,
+               Wheel.name, Soil.name, TestCondition, RunResult, StableWindow)
+        .join(Run.campaign).join(Run.condition).join(TestCondition.wheel)
+        .join(TestCondition.soil)
+        .join(RawFile, RawFile.run_pk == Run.id)
+        .join(newest_file, (newest_file.c.run_pk == RawFile.run_pk)
+              & (newest_file.c.version == RawFile.version))
+        .join(newest_result, newest_result.c.raw_file_id == RawFile.id)
+        .join(RunResult, RunResult.id == newest_result.c.result_id)
+        .join(StableWindow, StableWindow.id == RunResult.stable_window_id)
+        .order_by(Campaign.name, Run.run_id)).all()
+    result_ids = [row.RunResult.id for row in rows]
+    quantities = session.execute(select(RunQuantity).where(
+        RunQuantity.run_result_id.in_(result_ids))).scalars().all() if result_ids else []
+    by_result: dict[int, dict[str, float | None]] = {}
+    for q in quantities:
+        by_result.setdefault(q.run_result_id, {}).update(
+            {f"{q.quantity}_{stat}": getattr(q, stat) for stat in STATS})
+    records = []
+    for row in rows:
+        cond, result, window = row.TestCondition, row.RunResult, row.StableWindow
+        records.append({
+            "campaign": row[0], "run_id": row.run_id, "raw_file_version": row.version,
+            "raw_file_path": row.path, "raw_file_sha256": row.sha256, "wheel": row[5],
+            "soil": row[6], "mode": cond.mode, "multipass": cond.multipass,
+            "load_set_n": cond.load_n, "slip_setpoint": cond.slip_setpoint,
+            "velocity_set_mps": cond.velocity_mps, "gravity_mps2": cond.gravity_mps2,
+            "steer_deg": cond.steer_deg, "status": result.status,
+            "flags": "; ".join(result.flags), "window_found": window.found,
+            "window_start_s": window.start_s, "window_end_s": window.end_s,
+            "window_method": window.method, "no_window_reason": window.reason,
+            **by_result.get(result.id, {}), **result.oscillation,
+            "result_id": result.id})
+    return pd.DataFrame.from_records(records)

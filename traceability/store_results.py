@@ -1,0 +1,86 @@
+"""Persist stable windows and run results, once per (raw-file version, processing parameters)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from importlib.metadata import version
+from pathlib import Path
+from typing import Any
+
+from sqlalchemy import select
+from sqlalchemy.orm import Session
+
+from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
+from traceability.store import new_processing_record
+
+
+def params_sha256(parameters: dict[str, Any]) -> str:
+    """Hash of the processing parameters and the swtlab version (canonical JSON)."""
+    text = json.dumps({"swtlab": version("swtlab"), **parameters}, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def find_result(session: Session, raw_file: RawFile, params_hash: str) -> RunResult | None:
+    return session.scalars(select(RunResult).filter_by(raw_file_id=raw_file.id,
+                                                       params_sha256=params_hash)).first()
+
+
+def processed_file(session: Session, path: Path, sha256: str, params_hash: str) -> bool:
+    """Whether this exact file content at this path already has a result for these parameters."""
+    return session.scalars(
+        select(RunResult.id).join(RawFile, RawFile.id == RunResult.raw_file_id)
+        .where(RawFile.path == str(path.resolve()), RawFile.sha256 == sha256,
+               RunResult.params_sha256 == params_hash)).first() is not None
+
+
+def store_run_result(session: Session, raw_file: RawFile, result: Any,
+                     parameters: dict[str, Any]) -> RunResult:
+    """Store ``result`` (a ``run_results.RunResult``) with its window under one processing record."""
+    record = new_processing_record(session, "process", parameters)
+    w = result.window
+    window = StableWindow(raw_file_id=raw_file.id, found=w.found, start_s=w.start_s,
+                          end_s=w.end_s, method=w.method, parameters=jsonable(w.parameters),
+                          diagnostics=jsonable(w.diagnostics), reason=w.reason, processing=record)
+    row = RunResult(raw_file=raw_file, window=window, params_sha256=params_sha256(parameters),
+                    status=result.status, flags=list(result.flags),
+                    oscillation=jsonable(result.oscillation), corrections=jsonable(result.corrections),
+                    dp_trace=jsonable(result.dp_trace), processing=record,
+                    quantities=[RunQuantity(quantity=name, unit=q.unit, mean=_num(q.mean),
+                                            std=_num(q.std), se=_num(q.se), n=q.n,
+                                            n_eff=_num(q.n_eff))
+                                for name, q in result.quantities.items()])
+    session.add(row)
+    session.flush()
+    return row
+
+
+def store_ingest_failure(session: Session, path: Path, sha256: str, error: str,
+                         parameters: dict[str, Any]) -> None:
+    """Record a file that could not be read (once per path, content and message)."""
+    known = session.scalars(select(IngestFailure).filter_by(
+        path=str(path.resolve()), sha256=sha256, error=error)).first()
+    if known is None:
+        session.add(IngestFailure(path=str(path.resolve()), sha256=sha256, error=error,
+                                  processing=new_processing_record(session, "ingest", parameters)))
+
+
+def _num(value: Any) -> float | None:
+    """A finite float, or None for NaN/inf (JSON and every SQL backend accept NULL)."""
+    if value is None:
+        return None
+    value = float(value)
+    return value if value == value and abs(value) != float("inf") else None
+
+
+def jsonable(value: Any) -> Any:
+    """JSON-ready copy: numpy scalars to Python numbers, NaN/inf to None, tuples to lists."""
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [jsonable(v) for v in value]
+    if hasattr(value, "tolist"):
+        return jsonable(value.tolist())
+    if isinstance(value, float):
+        return _num(value)
+    return value

@@ -1,0 +1,136 @@
+"""Read a WPM CSV (docs/wpm-csv.md), ours or another tool's; every deviation from the page is
+a :class:`WpmFormatError` naming file, line and problem, never a silently different curve."""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from fitting.curve import DEGREES, PowerCurve
+from wpm_export.schema import COEFFICIENT_COLUMNS, COLUMNS, FORMAT, UNITS, WpmFormatError
+
+
+@dataclass(frozen=True)
+class WpmCurve(PowerCurve):
+    """One row of a WPM CSV: ``sum_i a_i slip**i`` on [slip_min, slip_max]."""
+
+    soil: str
+    wheel: str
+    multipass: int
+    load_n: float
+    quantity: str
+    unit: str
+    n_points: int
+    rmse: float
+    line: int
+
+
+def _number(text: str, column: str, problem) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise problem(f"{column} {text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise problem(f"{column} {text!r} is not finite")
+    return value
+
+
+def _integer(text: str, column: str, problem) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise problem(f"{column} {text!r} is not an integer") from None
+
+
+def _curve(fields: list[str], problem, line: int) -> WpmCurve:
+    """One data row -> curve, every rule of the page checked."""
+    if len(fields) != len(COLUMNS):
+        raise problem(f"{len(fields)} fields, the format has {len(COLUMNS)}")
+    row = dict(zip(COLUMNS, (f.strip() for f in fields)))
+    if not row["soil"] or not row["wheel"]:
+        raise problem("soil and wheel must not be empty")
+    quantity = row["quantity"]
+    if quantity not in UNITS:
+        raise problem(f"unknown quantity {quantity!r}; known: {', '.join(UNITS)}")
+    if row["unit"] != UNITS[quantity]:
+        raise problem(f"unit {row['unit']!r} for {quantity}; the format says {UNITS[quantity]!r}")
+    degree = _integer(row["degree"], "degree", problem)
+    if degree not in DEGREES:
+        raise problem(f"degree {degree} outside 3-7")
+    multipass = _integer(row["multipass"], "multipass", problem)
+    load_n = _number(row["load_n"], "load_n", problem)
+    slip_min = _number(row["slip_min"], "slip_min", problem)
+    slip_max = _number(row["slip_max"], "slip_max", problem)
+    if multipass < 0 or load_n <= 0:
+        raise problem(f"multipass {multipass} must be >= 0 and load_n {load_n:g} > 0")
+    if not -1.0 <= slip_min < slip_max <= 1.0:
+        raise problem(f"slip range [{slip_min:g}, {slip_max:g}]: need -1 <= slip_min < "
+                      "slip_max <= 1")
+    used = COEFFICIENT_COLUMNS[:degree + 1]
+    coefficients = tuple(_number(row[c], c, problem) for c in used)
+    for c in COEFFICIENT_COLUMNS[degree + 1:]:
+        if row[c] and _number(row[c], c, problem) != 0.0:
+            raise problem(f"{c} = {row[c]} beyond degree {degree} (must be empty or 0)")
+    n_points = _integer(row["n_points"], "n_points", problem)
+    if n_points < degree + 1:
+        raise problem(f"n_points {n_points} < degree + 1 = {degree + 1}: underdetermined fit")
+    rmse = _number(row["rmse"], "rmse", problem)
+    if rmse < 0:
+        raise problem(f"rmse {rmse:g} < 0")
+    return WpmCurve(coefficients=coefficients, slip_min=slip_min, slip_max=slip_max,
+                    soil=row["soil"], wheel=row["wheel"], multipass=multipass, load_n=load_n,
+                    quantity=quantity, unit=row["unit"], n_points=n_points, rmse=rmse, line=line)
+
+
+def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCurve]]:
+    """``(header, curves)`` of WPM CSV text; ``header`` maps the comment keys to values."""
+    header: dict[str, str] = {}
+    curves: list[WpmCurve] = []
+    seen: dict[tuple, int] = {}
+    columns_line = 0
+    for number, raw in enumerate(text.splitlines(), start=1):
+        def problem(message: str, _n=number) -> WpmFormatError:
+            return WpmFormatError(path, _n, message)
+        if not raw.strip():
+            continue
+        if not columns_line:
+            if raw.startswith("#"):
+                key, sep, value = raw[1:].partition(":")
+                if not sep:
+                    raise problem("header comment must read '# key: value'")
+                header[key.strip()] = value.strip()
+                if len(header) == 1 and key.strip() != "format":
+                    raise problem(f"first line must be '# format: {FORMAT}'")
+                continue
+            if header.get("format") != FORMAT:
+                raise problem(f"missing '# format: {FORMAT}' line before the column header"
+                              if "format" not in header else
+                              f"format {header['format']!r}, this reader reads {FORMAT!r}")
+            if tuple(f.strip() for f in next(csv.reader([raw]))) != COLUMNS:
+                raise problem(f"column header must be {','.join(COLUMNS)}")
+            columns_line = number
+            continue
+        curve = _curve(next(csv.reader([raw])), problem, number)
+        key = (curve.soil, curve.wheel, curve.multipass, curve.load_n, curve.quantity)
+        if key in seen:
+            raise problem(f"duplicate curve {key} (also line {seen[key]})")
+        seen[key] = number
+        curves.append(curve)
+    if not columns_line:
+        raise WpmFormatError(path, 0, "no column header" if header else
+                             f"empty file: no '# format: {FORMAT}' line")
+    if not curves:
+        raise WpmFormatError(path, columns_line, "no curve rows after the column header")
+    return header, curves
+
+
+def read_wpm_csv(path) -> tuple[dict[str, str], list[WpmCurve]]:
+    """Read a WPM CSV file; raises :class:`WpmFormatError` (also for a non-UTF-8 file)."""
+    data = Path(path).read_bytes()
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise WpmFormatError(path, data[:exc.start].count(b"\n") + 1, "not UTF-8") from None
+    return parse_wpm_csv(text, path)

@@ -1,0 +1,25 @@
+"""The WPM CSV format ``swtlab-wpm/1`` (docs/wpm-csv.md): columns, quantities, errors."""
+
+from __future__ import annotations
+
+from fitting.curve import DEGREES, QUANTITY_UNITS
+
+FORMAT = "swtlab-wpm/1"
+MAX_DEGREE = max(DEGREES)
+COEFFICIENT_COLUMNS = tuple(f"a{i}" for i in range(MAX_DEGREE + 1))
+COLUMNS = (("soil", "wheel", "multipass", "load_n", "quantity", "unit", "degree", "slip_min",
+            "slip_max") + COEFFICIENT_COLUMNS + ("n_points", "rmse"))
+UNITS = QUANTITY_UNITS  # dp_n N, torque_nm N*m, sinkage_m m, resistance_n N, dp_over_w 1
+
+
+class WpmFormatError(ValueError):
+    """A WPM CSV that does not follow docs/wpm-csv.md; names file, line and problem."""
+
+    def __init__(self, path, line: int, problem: str) -> None:
+        super().__init__(f"{path}:{line}: {problem}")
+        self.path, self.line, self.problem = str(path), line, problem
+
+
+class WpmSelectionError(ValueError):
+    """A query the loaded curves cannot answer unambiguously (no or several matching curve
+    sets, a quantity the set lacks); lists the choices."""
