@@ -24,7 +24,9 @@ demo: $(STAMP)
 	mkdir -p $(OUT)
 	$(BIN)/swtlab process sample_data/campaign --db sqlite:///$(OUT)/swtlab.sqlite
 	$(BIN)/swtlab results --db sqlite:///$(OUT)/swtlab.sqlite --csv $(OUT)/results.csv
-	@echo "results: database $(OUT)/swtlab.sqlite, one row per run in $(OUT)/results.csv"
+	$(BIN)/swtlab export --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/wpm.csv
+	$(BIN)/swtlab wpm query $(OUT)/wpm.csv --load 120 --dp 25 --multipass 0
+	@echo "results: database $(OUT)/swtlab.sqlite, one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

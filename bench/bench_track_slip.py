@@ -20,7 +20,7 @@ def _accuracy(count: int) -> dict:
     slips = np.linspace(0.0, 0.8, count)
     for i, slip in enumerate(slips):
         rng = np.random.default_rng(50_000 + i)
-        px_per_m = float(rng.uniform(600, 1100))
+        px_per_m = float(rng.uniform(600, 900))
         image, truth = render_track(float(slip), RADIUS_M, GROUSERS, HEIGHT_M, px_per_m, seed=i,
                                     nuisance=random_nuisance(60_000 + i, SIZE_PX))
         start = time.perf_counter()

@@ -12,6 +12,7 @@ from itertools import chain
 from pathlib import Path
 
 import numpy as np
+import orjson
 from mcap.reader import NonSeekingReader, make_reader
 
 from ingest.errors import IngestError
@@ -62,12 +63,21 @@ def _swt_records(metadata) -> dict[str, dict[str, str]]:
     return {m.name[4:]: dict(m.metadata) for m in metadata if m.name.startswith("swt.")}
 
 
+def _loads(message: bytes):
+    """orjson (several times faster on long numeric arrays); the standard library for what
+    orjson refuses, such as the ``NaN``/``Infinity`` tokens the checks then report by channel."""
+    try:
+        return orjson.loads(message)
+    except orjson.JSONDecodeError:
+        return json.loads(message)
+
+
 def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
     """Concatenate a topic's blocks (ordered by their first time stamp) into field arrays."""
     blocks = []
     for i, message in enumerate(data):
         try:
-            blocks.append(json.loads(message))
+            blocks.append(_loads(message))
         except (ValueError, UnicodeDecodeError) as exc:
             raise IngestError(path, topic, f"message {i} is not valid JSON ({exc}); "
                               f"{_HINT}") from None

@@ -6,11 +6,12 @@ reads ground truth.
 
 from run_results.corrections import RigCompliance, corrected_heights, tare_record
 from run_results.modes import towed_vs_powered
-from run_results.oscillation import harmonic_fit, measure_frequency_hz, waveform_peaks
+from run_results.oscillation import harmonic_fit, measure_frequency_hz
+from run_results.phase_average import phase_average
 from run_results.process import process_run
 from run_results.result import RunResult
 from run_results.stats import QuantityStats, quantity_stats
 
 __all__ = ["QuantityStats", "RigCompliance", "RunResult", "corrected_heights", "harmonic_fit",
-           "measure_frequency_hz", "process_run", "quantity_stats", "tare_record",
-           "towed_vs_powered", "waveform_peaks"]
+           "measure_frequency_hz", "phase_average", "process_run", "quantity_stats",
+           "tare_record", "towed_vs_powered"]

@@ -1,4 +1,4 @@
-"""Grouser passing oscillation in the forces: measured frequency, waveform, peaks.
+"""Grouser passing frequency measured in the forces.
 
 The grousers load the wheel periodically at ``n omega / 2 pi`` (Irani et al., J.
 Terramechanics 48, 2011). Over a window of a few periods a plain spectrum resolves the
@@ -6,8 +6,6 @@ frequency only to ``1/duration``, so the peak of a zero-padded Hann-windowed FFT
 expected frequency is refined by least squares: the frequency whose harmonic series
 (``harmonics`` terms, with mean and linear trend) explains most of the signal (the
 maximum-likelihood frequency of a periodic signal in white noise; Quinn & Hannan 2001).
-The fitted waveform (mean + harmonics) gives the peak and peak-to-peak values free of
-sensor noise and gravel spikes.
 """
 
 from __future__ import annotations
@@ -15,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-HARMONICS = 12
+HARMONICS = 6
 SEARCH_RATIO = 0.4   # look for the peak within +-40 % of the expected frequency
 
 
@@ -30,11 +28,8 @@ def harmonic_fit(t_s, y, frequency_hz: float, harmonics: int = HARMONICS) -> dic
     t_s, y = np.asarray(t_s, float), np.asarray(y, float)
     ok = np.isfinite(y)
     a = _design(t_s[ok], frequency_hz, harmonics)
-    coef, *_ = np.linalg.lstsq(a, y[ok], rcond=None)
-    periodic = np.full(t_s.size, np.nan)
-    periodic[ok] = a[:, 2:] @ coef[2:]
-    return {"coef": coef, "periodic": periodic,
-            "rss": float(np.sum((y[ok] - a @ coef) ** 2)), "harmonics": harmonics}
+    coef = np.linalg.solve(a.T @ a, a.T @ y[ok])   # normal equations: 2k+2 unknowns
+    return {"coef": coef, "rss": float(np.sum((y[ok] - a @ coef) ** 2)), "harmonics": harmonics}
 
 
 def measure_frequency_hz(t_s, y, expected_hz: float, harmonics: int = HARMONICS) -> float:
@@ -58,12 +53,3 @@ def measure_frequency_hz(t_s, y, expected_hz: float, harmonics: int = HARMONICS)
                              bounds=(max(coarse - width, 1e-6), coarse + width), method="bounded",
                              options={"xatol": 1e-5 * expected_hz})
     return float(result.x)
-
-
-def waveform_peaks(t_s, y, frequency_hz: float, harmonics: int = HARMONICS) -> dict:
-    """Peak and peak-to-peak of the fitted periodic waveform (mean + harmonics) over one period."""
-    fit = harmonic_fit(t_s, y, frequency_hz, harmonics)
-    coef = fit["coef"]
-    phase = np.linspace(0.0, 2.0 * np.pi, 721)[:, None] * np.arange(1, harmonics + 1)
-    wave = coef[0] + np.cos(phase) @ coef[2:2 + harmonics] + np.sin(phase) @ coef[2 + harmonics:]
-    return {"peak": float(wave.max()), "peak_to_peak": float(wave.max() - wave.min())}

@@ -5,15 +5,20 @@ slip, travel velocity, wheel angular velocity, wheel load ``fz``, drawbar pull, 
 torque ``ty``, thrust ``H = T/r``, motion resistance ``R = T/r - DP`` (Wong, Theory of
 Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correction; for
 steered runs also the side force ``fy`` and the slip angle (logged channel, else the
-set steering angle).
+set steering angle). Single-channel quantities come from the native samples, the means of
+resistance and sinkage from the channels' native means (``native``).
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
 from run_results import oscillation as osc
 from run_results.corrections import RigCompliance, corrected_heights, tare_record
+from run_results.native import native_quantities
+from run_results.phase_average import phase_average
 from run_results.result import RunResult
 from run_results.stats import quantity_stats
 from stable_phase import StablePhaseParams, detect_stable_phase
@@ -84,14 +89,14 @@ def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
     for key, name, unit in (("dp_n", "dp", "n"), ("torque_nm", "torque", "nm")):
         y = series[key][0][lo:hi]
         if frequency and np.isfinite(y).mean() > 0.5 and key in candidates:
-            peaks = osc.waveform_peaks(t[lo:hi], y, frequency)
-            out[f"{name}_peak_{unit}"] = peaks["peak"]
-            out[f"{name}_peak_to_peak_{unit}"] = peaks["peak_to_peak"]
+            wave = phase_average(t[lo:hi], y, frequency)["waveform"]
+            out[f"{name}_peak_{unit}"] = float(np.nanmax(wave))
+            out[f"{name}_peak_to_peak_{unit}"] = float(np.nanmax(wave) - np.nanmin(wave))
         else:
             out[f"{name}_peak_{unit}"] = out[f"{name}_peak_to_peak_{unit}"] = None
     out["method"] = ("Hann zero-padded FFT peak within +-40 % of n*omega/2pi, refined by "
                      f"least squares on a {osc.HARMONICS}-harmonic series; peaks from the "
-                     "fitted waveform")
+                     "phase-averaged waveform")
     return out, frequency
 
 
@@ -135,12 +140,17 @@ def process_run(run, params: StablePhaseParams | None = None,
     oscillation, frequency = _oscillation(run, t, lo, hi, series)
     quantities = {}
     for key, (y, unit) in series.items():
-        periodic = None
+        average = None
         if frequency and np.isfinite(y[lo:hi]).sum() > 16:
-            periodic = osc.harmonic_fit(t[lo:hi], y[lo:hi], frequency)["periodic"]
-        stats = quantity_stats(y[lo:hi], unit, periodic)
+            average = phase_average(t[lo:hi], y[lo:hi], frequency)
+        stats = quantity_stats(y[lo:hi], unit, average)
         if stats is not None:
             quantities[key] = stats
+    native, combined = native_quantities(run, window.start_s, window.end_s,
+                                         {k: u for k, (_, u) in series.items()}, frequency, rig)
+    quantities.update({k: v for k, v in native.items() if k in quantities})
+    quantities.update({k: replace(quantities[k], mean=v) for k, v in combined.items()
+                       if k in quantities})
     corrections["hub_height_correction_mean_m"] = float(np.nanmean(applied["correction_m"][lo:hi]))
     flags = tuple(_flags(run, window, oscillation))
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,

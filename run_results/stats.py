@@ -4,12 +4,12 @@ The standard error is corrected for autocorrelation by the statistical inefficie
 (``stable_phase.autocorr``: integrated autocorrelation time with Geyer's initial positive
 sequence; Sokal 1997, Geyer 1992; Flyvbjerg & Petersen 1989 for the equivalent blocking).
 
-The grouser oscillation is deterministic and periodic: the window holds a whole number of
-periods, so it adds nothing to the mean beyond the rounding of the period to samples. It
-would, however, make the autocorrelation ring and inflate ``g`` for no statistical reason,
-so it is removed (least-squares harmonic series at the measured passing frequency, see
-``oscillation``) before ``g`` and the SE are computed. ``std`` is the plain spread of the
-samples, oscillation included (what a single reading scatters by).
+The grouser oscillation is deterministic and periodic: over a whole number of periods it
+adds nothing to the mean, but it would make the autocorrelation ring and inflate ``g`` for
+no statistical reason. With grousers the mean is therefore the mean of the phase-averaged
+waveform (``phase_average``: every phase weighted equally, gaps harmless) and the SE is
+that estimator's, computed from the residual about the waveform. ``std`` is the plain
+spread of the samples, oscillation included (what a single reading scatters by).
 """
 
 from __future__ import annotations
@@ -36,18 +36,29 @@ class QuantityStats:
         return asdict(self)
 
 
-def quantity_stats(y, unit: str, periodic=None) -> QuantityStats | None:
-    """Stats of ``y`` over the window; ``periodic`` (same length) is removed for the SE only.
+def quantity_stats(y, unit: str, average: dict | None = None) -> QuantityStats | None:
+    """Stats of ``y`` over the window; None when fewer than two samples are finite.
 
-    None when fewer than two samples are finite.
+    Without ``average``: plain mean, ``se = s sqrt(g/n)``. With a phase average of ``y``
+    (``phase_average``): its mean of bin means, and the SE of that estimator,
+    ``se^2 = g s_r^2 sum_b(1/n_b) / B^2`` with ``s_r^2`` the residual variance about the
+    waveform on ``n - B`` degrees of freedom and ``g`` the residual's statistical inefficiency.
     """
     y = np.asarray(y, float)
     ok = np.isfinite(y)
     n = int(ok.sum())
     if n < 2:
         return None
-    resid = y[ok] if periodic is None else y[ok] - np.nan_to_num(np.asarray(periodic)[ok])
+    std = float(np.std(y[ok], ddof=1))
+    if average is None:
+        g = statistical_inefficiency(y[ok])
+        return QuantityStats(mean=float(np.mean(y[ok])), std=std, se=std * float(np.sqrt(g / n)),
+                             n=n, n_eff=float(n / g), unit=unit)
+    resid = y[ok] - average["periodic"][ok] - average["mean"]
+    counts = average["counts"][average["counts"] > 0]
+    dof = max(n - counts.size, 1)
     g = statistical_inefficiency(resid)
-    se = float(np.std(resid, ddof=1) * np.sqrt(g / n))
-    return QuantityStats(mean=float(np.mean(y[ok])), std=float(np.std(y[ok], ddof=1)), se=se,
-                         n=n, n_eff=float(n / g), unit=unit)
+    var_factor = float(np.sum(1.0 / counts)) / counts.size**2
+    se = float(np.sqrt(g * np.sum(resid**2) / dof * var_factor))
+    return QuantityStats(mean=average["mean"], std=std, se=se, n=n,
+                         n_eff=float(1.0 / (g * var_factor)), unit=unit)

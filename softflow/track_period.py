@@ -19,7 +19,8 @@ MIN_PEAK = 8.0  # a fundamental's own peak over the local median power (noise: p
 HARMONICS = 8
 MIN_PROMINENCE = 60.0  # harmonic sum of peak-over-median ratios (noise on sand: 15-50)
 MIN_CORRELATION = 0.3  # a window holds a mark when it matches the mean waveform this well
-MIN_FIT_MARKS = 4  # for a quadratic with a residual
+MIN_FIT_MARKS = 4  # for a fit with a residual
+MIN_QUADRATIC_MARKS = 12  # fewer marks: a straight line (perspective curvature not fitted)
 PAD = 4  # zero padding of the profile spectrum
 
 
@@ -42,7 +43,8 @@ def prominence_spectrum(profile: np.ndarray,
     which keeps every period in range) and Hann-windowed profile, and power over its
     running median across 24 bins (noise: the ratio exceeds r with probability
     exp(-r ln 2))."""
-    x = (profile - gaussian_filter1d(profile, max_period, mode="reflect")) * np.hanning(profile.size)
+    x = profile - gaussian_filter1d(profile, max_period, mode="reflect")
+    x *= np.hanning(profile.size)
     freq = np.fft.rfftfreq(PAD * profile.size)
     power = np.abs(np.fft.rfft(x, PAD * profile.size)) ** 2
     background = median_filter(power, 24 * PAD + 1, mode="nearest")
@@ -113,7 +115,7 @@ def _robust_fit(k: np.ndarray, x: np.ndarray, floor: float) -> np.ndarray:
 def _mark_positions(hp: np.ndarray, period: float) -> tuple[np.ndarray, np.ndarray, int]:
     """Index and sub-sample position of every one-period window matching the mean mark
     waveform (normalised correlation >= MIN_CORRELATION), and the number of windows."""
-    count = int(np.clip(period / 6, 1, 8))
+    count = int(np.clip(period / 6, 1, 8))  # harmonics of the mean waveform
     c = _harmonics(hp, period, count)
     h = np.arange(1, count + 1)
     phase = np.linspace(0, 1, 512, endpoint=False)
@@ -155,11 +157,14 @@ def fit_marks(profile: np.ndarray, period: float, reference: float,
         if k.size < MIN_FIT_MARKS:
             return MarkFit(period, np.inf, x, k, windows, np.inf)
         kc = k - k.mean()
-        coef, cov = np.polyfit(kc, x, 2, cov="unscaled")
+        degree = 2 if k.size >= MIN_QUADRATIC_MARKS else 1
+        coef, cov = np.polyfit(kc, x, degree, cov="unscaled")
+        if degree == 1:  # as a quadratic with no curvature
+            coef, cov = np.r_[0.0, coef], np.pad(cov, ((1, 0), (1, 0)))
         res = x - np.polyval(coef, kc)
         k_ref = np.clip((reference - coef[2]) / coef[1], kc.min(), kc.max())
         grad = np.array([2 * k_ref, 1.0, 0.0])
         spacing = float(coef[1] + 2 * coef[0] * k_ref)
-        se = float(np.sqrt(np.sum(res**2) / max(k.size - 3, 1) * grad @ cov @ grad))
+        se = float(np.sqrt(np.sum(res**2) / max(k.size - degree - 1, 1) * grad @ cov @ grad))
         period = float(coef[1])
     return MarkFit(spacing, se, x, k, windows, float(np.sqrt(np.mean(res**2))))

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy.ndimage import map_coordinates, uniform_filter1d
+from scipy.ndimage import map_coordinates, maximum_filter1d, uniform_filter1d
 
 STEP_PX = 0.5  # along-track sampling of the profile
 
@@ -30,14 +30,14 @@ class Strip:
 
 
 def direction_candidates(gray: np.ndarray, min_period_px: float, max_period_px: float,
-                         separation_deg: float = 10.0) -> list[tuple[float, float]]:
-    """Candidate (direction in rad in [0, pi), frequency in cycles/px), likeliest first.
+                         separation_deg: float = 10.0) -> list[tuple[float, np.ndarray]]:
+    """Candidate (direction in rad in [0, pi), frequencies in cycles/px), likeliest first.
 
     The power spectrum is resampled on a polar grid and divided by its mean over angle
     (sand and noise are isotropic). The marks put power along the track direction and
     the track's straight edges across it, so the two angles of highest mean whitened
-    power are taken, each with its perpendicular; the frequency is the strongest one
-    along the candidate direction.
+    power are taken, each with its perpendicular; the frequencies are the three strongest
+    local peaks along the candidate direction.
     """
     h, w = gray.shape
     win = np.outer(np.hanning(h), np.hanning(w)).astype(np.float32)
@@ -58,7 +58,9 @@ def direction_candidates(gray: np.ndarray, min_period_px: float, max_period_px: 
     out = []
     for angle in dict.fromkeys(angles):
         i = int(np.argmin(_angle_gap(theta, angle)))
-        out.append((float(angle), float(freq[int(np.argmax(polar[i]))])))
+        line = polar[i]
+        peaks = np.flatnonzero((line == maximum_filter1d(line, 9)) & (line > 0))
+        out.append((float(angle), freq[peaks[np.argsort(line[peaks])[::-1][:3]]]))
     return out
 
 
@@ -91,15 +93,16 @@ def _row_demodulation(strip: Strip, freq_per_sample: float) -> np.ndarray:
     return (both[:, 0] + 1j * both[:, 1]) / n
 
 
-def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int, int]:
+def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int, int, float]:
     """Rows [lo, hi) whose summed profile carries the pattern at the frequency with the
     best signal-to-noise ratio: |coherent sum of the rows' complex amplitudes| over the
     square root of the samples summed (noise adds up incoherently), maximised over every
-    contiguous band of at least 3 rows among the rows at least ``min_len`` long."""
+    contiguous band of at least 3 rows among the rows at least ``min_len`` long; and that
+    ratio (in units of the image noise)."""
     n = strip.valid.sum(axis=1)
     rows = np.flatnonzero(n >= min_len)
     if rows.size < 3:
-        return 0, 0
+        return 0, 0, 0.0
     first, last = rows[0], rows[-1] + 1
     n = n[first:last] * (n[first:last] >= min_len)
     z = _row_demodulation(strip, freq_per_sample)[first:last] * n
@@ -110,7 +113,24 @@ def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int
     snr = (np.abs(total[hi] - total[lo]) / np.sqrt(np.maximum(count[hi] - count[lo], 1))
            * (hi - lo >= 3))
     lo_best, hi_best = np.unravel_index(int(np.argmax(snr)), snr.shape)
-    return int(first + lo_best), int(first + hi_best)
+    return int(first + lo_best), int(first + hi_best), float(snr[lo_best, hi_best])
+
+
+def shear_slope(strip: Strip, lo: int, hi: int, freq_per_sample: float) -> float:
+    """Along-track shift of the pattern per row across rows [lo, hi) (px per px): the
+    linear phase ramp across the rows that maximises their coherent sum. The direction
+    is off by ``atan`` of it."""
+    cols = strip.valid[lo:hi].all(axis=0)
+    rows = Strip(strip.angle_rad, np.where(cols, strip.samples[lo:hi], 0.0),
+                 np.broadcast_to(cols, (hi - lo, cols.size)), strip.along_start_px)
+    z = _row_demodulation(rows, freq_per_sample)
+    slopes = np.linspace(-0.5, 0.5, 1001)
+    ramp = -2 * np.pi * freq_per_sample * slopes / STEP_PX  # phase step per row
+    total = np.abs(np.exp(-1j * np.outer(ramp, np.arange(z.size))) @ z)
+    i = int(np.clip(np.argmax(total), 1, slopes.size - 2))
+    lo_, mid, hi_ = total[i - 1:i + 2]
+    shift = 0.5 * (lo_ - hi_) / (lo_ - 2 * mid + hi_) if lo_ - 2 * mid + hi_ < 0 else 0.0
+    return float(slopes[i] + shift * (slopes[1] - slopes[0]))
 
 
 def coherence(strip: Strip, lo: int, hi: int, freq_per_sample: float) -> float:

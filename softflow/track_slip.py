@@ -5,7 +5,8 @@ equally spaced grousers the theoretical grouser distance is ``d = 2*pi*r/n``; th
 marks in the track lie ``d*(1 - s)`` apart, so ``s = 1 - d_track*n/(2*pi*r)``.
 ``r`` is the radius WITHOUT grousers, the one that defines the encoder slip (raw-run
 spec): the mark spacing is the hub travel per grouser pitch, ``(v/omega)*2*pi/n``,
-whatever the grouser height (docs/track-slip.md shows it with the renderer).
+whatever the grouser height (docs/track-slip.md shows it with the renderer). A braked
+wheel (marks farther apart than ``2*pi*r/n``) gets the spec's skid ``(r*omega - v)/v``.
 The spacing is measured over the whole visible track with sub-pixel precision.
 """
 
@@ -21,6 +22,7 @@ from softflow import track_period, track_profile
 
 MIN_MARKS = 5  # marks needed for a spacing
 MIN_FOUND_FRACTION = 0.5  # of the one-period windows along the visible track
+ANGLE_REFINEMENTS = 4
 MIN_COHERENCE = 0.85  # |sum of row amplitudes| / sum of |row amplitudes| across the band
 MAX_RESIDUAL = 0.12  # RMS of mark positions about the line, fraction of the spacing
 
@@ -64,6 +66,16 @@ def scale_from_points(points_px, distance_m: float,
     return length_px / distance_m, np.sqrt(2) * point_std_px / length_px
 
 
+def slip_from_spacing(spacing_m: float, theoretical_m: float,
+                      spacing_rel_std: float = 0.0) -> tuple[float, float]:
+    """Slip and its std from the mark spacing (raw-run spec): driving ``1 - d/d0`` while the
+    marks are closer than ``d0 = 2*pi*r/n`` (r*omega > v), skid ``d0/d - 1`` beyond."""
+    ratio = spacing_m / theoretical_m
+    if ratio <= 1:
+        return float(1 - ratio), float(ratio * spacing_rel_std)
+    return float(1 / ratio - 1), float(spacing_rel_std / ratio)
+
+
 def _gray(image) -> np.ndarray:
     if isinstance(image, (str, Path)):
         try:
@@ -82,13 +94,26 @@ def _gray(image) -> np.ndarray:
     return image.astype(np.float32)
 
 
-def _measure_direction(gray, angle_rad, freq_px, min_period_px, max_period_px, reference_px):
-    """Mark fit along one candidate direction: (fit, prominence) or the reason it failed.
+def _measure_direction(gray, angle_rad, freqs_px, min_period_px, max_period_px, reference_px):
+    """Mark fit along one candidate direction, refined: (fit, prominence, direction) or the
+    reason it failed. ``freqs_px`` are candidate frequencies (cycles/px): the one whose band
+    of rows carries its pattern with the best signal-to-noise ratio leads.
     ``reference_px`` is the image point (from the centre) where the scale applies."""
     step = track_profile.STEP_PX
     min_period, max_period = min_period_px / step, max_period_px / step
     strip = track_profile.resample(gray, angle_rad)
-    lo, hi = track_profile.find_band(strip, freq_px * step, min_len=4 / (freq_px * step))
+    bands = [(*track_profile.find_band(strip, f * step, 4 / (f * step)), f * step)
+             for f in freqs_px]
+    *_, freq = max(bands, key=lambda band: band[2])
+    for refinement in range(ANGLE_REFINEMENTS + 1):
+        lo, hi, _ = track_profile.find_band(strip, freq, min_len=4 / freq)
+        if hi - lo < 3:
+            return "no band of marks"
+        slope = track_profile.shear_slope(strip, lo, hi, freq)
+        if abs(slope) < 0.005 or refinement == ANGLE_REFINEMENTS:
+            break
+        angle_rad -= np.arctan(slope)
+        strip = track_profile.resample(gray, angle_rad)
     profile, first = track_profile.band_profile(strip, lo, hi)
     if profile.size < 4 * min_period:
         return "no band of marks"
@@ -108,7 +133,11 @@ def _measure_direction(gray, angle_rad, freq_px, min_period_px, max_period_px, r
         return f"{used} of {fit.windows} marks matched"
     if fit.residual_rms > MAX_RESIDUAL * fit.spacing:
         return "marks not evenly spaced"
-    return fit, prominence
+    return fit, prominence, angle_rad
+
+
+def _relative_se(fit: track_period.MarkFit) -> float:
+    return fit.spacing_se / fit.spacing
 
 
 def measure_track_slip(image, radius_m: float, grouser_count: int, px_per_m: float | None = None,
@@ -139,12 +168,12 @@ def measure_track_slip(image, radius_m: float, grouser_count: int, px_per_m: flo
                     else np.asarray(scale_points, float).mean(axis=0) - centre)
     max_period_px = max(gray.shape) / 4
     best, reasons = None, []
-    for angle, freq in track_profile.direction_candidates(gray, min_period_px, max_period_px):
-        found = _measure_direction(gray, angle, freq, min_period_px, max_period_px, reference_px)
+    for angle, freqs in track_profile.direction_candidates(gray, min_period_px, max_period_px):
+        found = _measure_direction(gray, angle, freqs, min_period_px, max_period_px, reference_px)
         if isinstance(found, str):
             reasons.append(found)
-        elif best is None or found[1] > best[1]:
-            best = (*found, angle)
+        elif best is None or _relative_se(found[0]) < _relative_se(best[0]):
+            best = found  # the most precise spacing among the directions that pass
     if best is None:
         raise NoPeriodicMarksError("; ".join(dict.fromkeys(reasons)))
     fit, prominence, angle = best
@@ -153,9 +182,9 @@ def measure_track_slip(image, radius_m: float, grouser_count: int, px_per_m: flo
     spacing_m = spacing_px / px_per_m
     spacing_rel_std = float(np.hypot(fit.spacing_se / fit.spacing, scale_rel_std))
     theoretical_m = 2 * np.pi * radius_m / grouser_count
+    slip, slip_std = slip_from_spacing(spacing_m, theoretical_m, spacing_rel_std)
     return TrackSlipResult(
-        slip=float(1 - spacing_m / theoretical_m),
-        slip_std=float(spacing_m / theoretical_m * spacing_rel_std),
+        slip=slip, slip_std=slip_std,
         spacing_m=float(spacing_m), spacing_std_m=float(spacing_m * spacing_rel_std),
         theoretical_spacing_m=float(theoretical_m), marks_used=int(fit.indices.size),
         marks_expected=int(fit.windows), track_angle_deg=float(np.degrees(angle) % 180),

@@ -10,14 +10,16 @@ made monotone non-increasing. The standard error of the mean is ``s sqrt(g/n)``,
 from __future__ import annotations
 
 import numpy as np
+from scipy import fft
 
 
 def autocorrelation(x: np.ndarray) -> np.ndarray:
     """Normalised autocorrelation ``rho_k`` for k = 0..n-1 (FFT, biased estimator)."""
     x = np.asarray(x, float) - np.mean(x)
     n = x.size
-    spectrum = np.fft.rfft(x, 2 * n)
-    acov = np.fft.irfft(spectrum * np.conj(spectrum))[:n]
+    size = fft.next_fast_len(2 * n, real=True)  # zero padding >= n: no circular wrap
+    spectrum = fft.rfft(x, size)
+    acov = fft.irfft(spectrum * np.conj(spectrum), size)[:n]
     return acov / acov[0] if acov[0] > 0 else np.zeros(n)
 
 

@@ -57,7 +57,8 @@ def _check(t: np.ndarray, signals: dict, limits: dict, params: StablePhaseParams
     for name, y in signals.items():
         test = slope_test(t, y)
         test["limit"] = limits.get(name, float("inf"))
-        test["drifts"] = bool(test["p"] < params.slope_alpha and abs(test["change"]) > test["limit"])
+        test["drifts"] = bool(test["p"] < params.slope_alpha
+                              and abs(test["change"]) > test["limit"])
         test["r_hat"] = split_r_hat(y)
         out[name] = test
     return out

@@ -112,8 +112,8 @@ def speed_gate(run, params: StablePhaseParams) -> Gate:
     if segment is None:
         return Gate(None, None, None, diagnostics)
     ramp = ramp_start(relative, segment[0], int(round(params.ramp_lookback_s * rate_hz)))
-    diagnostics.update({"gate_start_s": float(t[segment[0]]), "gate_end_s": float(t[segment[1] - 1]),
-                        "ramp_start_s": float(t[ramp])})
+    diagnostics.update({"gate_start_s": float(t[segment[0]]),
+                        "gate_end_s": float(t[segment[1] - 1]), "ramp_start_s": float(t[ramp])})
     return Gate(segment[0], segment[1], ramp, diagnostics)
 
 

@@ -18,7 +18,7 @@ class StablePhaseParams:
     settle_fraction: float = 0.005        # stable once the transient is 0.5 % of its excursion
     batch_s: float = 1.0                  # MSER batch spacing (means over one grouser period)
     mser_max_cut_fraction: float = 0.5    # MSER may cut at most half the gated segment
-    end_max_cut_fraction: float = 0.1     # after the settling cut, MSER trims at most 10 % off the end
+    end_max_cut_fraction: float = 0.1     # after the settling cut MSER trims <= 10 % off the end
     min_window_s: float = 5.0             # shorter windows are not a stable phase
     min_grouser_periods: int = 2          # ... nor windows holding fewer grouser periods
     slope_alpha: float = 0.01             # slope test significance level

@@ -4,16 +4,18 @@ Sinkage and the forces settle roughly exponentially after the wheel reaches its 
 speeds (soil compaction under the passing wheel; raw-run spec: "about 25 s at 40 m/h on
 ES-3"). Each signal, averaged over one grouser period, is fitted with
 ``y = a + b exp(-max(t - t_on, 0)/tau)`` (onset ``t_on`` fitted too) from the ramp start
-(where the speeds began to move to their set points) to the gate's end. The first signal, in the order given (hub height,
-sinkage, drawbar pull, torque: the hub height is the soil's state seen by the suspension
-encoder alone, free of the load cell's drift that enters a flexible wheel's sinkage;
-resistance follows it, and DP mixes the fast shear build-up with it), whose transient stands out from its residual
-(``|b|/sigma >= 10``) sets the start ``t_on + tau ln(1/f)``, where
-``f = settle_fraction`` (0.5 %: ``5.3 tau``, the settling-time convention with a 0.5 %
-band), and never before the gate opens. Without a clear transient the
-window opens at the gate. Where the transient is no exponential (a rig lowering the wheel
-in steps) and the fitted start leaves less than ``min_window_s``, the two-sided MSER cut of
-that signal is used instead (``fallback`` in the diagnostics).
+(where the speeds began to move to their set points) to the gate's end.
+
+The first signal, in the order hub height, sinkage, drawbar pull, torque, whose transient
+stands out from its residual (``|b|/sigma >= 10``) sets the start ``t_on + tau ln(1/f)``
+with ``f = settle_fraction`` (0.5 %: ``5.3 tau``, the settling-time convention with a
+0.5 % band), never before the gate opens. The hub height comes first: it is the soil's
+state seen by the suspension encoder alone, free of the load-cell drift that enters a
+flexible wheel's sinkage; resistance follows it, and DP mixes the fast shear build-up in.
+Without a clear transient the window opens at the gate. Where the transient is no
+exponential (a rig lowering the wheel in steps) and the fitted start leaves less than
+``min_window_s``, the two-sided MSER cut of that signal is used instead (``fallback``).
+
 The end is cut by two-sided MSER with the start held (see ``mser``), by at most
 ``end_max_cut_fraction`` of the rest: the speed gate has already removed the deceleration,
 and MSER over-truncates autocorrelated batch means.
@@ -29,6 +31,9 @@ from stable_phase.registry import Cut, register
 from stable_phase.signals import moving_average
 
 MIN_SNR = 10.0
+#: the smoothed signals are fitted on at most this many points (decimated after the
+#: period-long moving average, which has already removed what decimation would alias)
+FIT_POINTS = 5000
 
 
 def _exponential(t, a, b, tau, t0):
@@ -64,12 +69,15 @@ class SettlingDetector:
     def locate(self, t_s, signals, period_s, params, gate_start) -> Cut:
         dt = float(np.median(np.diff(t_s)))
         width = max(int(round((period_s or params.batch_s) / dt)), 1)
-        fits = {name: fit_settling(t_s, moving_average(y, width, full_only=True)) for name, y in signals.items()}
+        step = -(-t_s.size // FIT_POINTS)
+        fits = {name: fit_settling(t_s[::step], moving_average(y, width, full_only=True)[::step])
+                for name, y in signals.items()}
         fits = {k: v for k, v in fits.items() if v is not None}
         best = next((k for k, v in fits.items() if v["snr"] >= MIN_SNR), None)
         start = gate_start
         if best is not None:
-            start_s = fits[best]["onset_s"] + fits[best]["tau_s"] * np.log(1.0 / params.settle_fraction)
+            fit = fits[best]
+            start_s = fit["onset_s"] + fit["tau_s"] * np.log(1.0 / params.settle_fraction)
             start = max(gate_start, int(np.searchsorted(t_s, start_s)))
         fallback = None
         min_samples = int(round(params.min_window_s / dt))

@@ -241,3 +241,14 @@ def db_url(request, tmp_path):
     with admin.connect() as connection:
         connection.execute(text(f'DROP DATABASE "{name}" WITH (FORCE)'))
     admin.dispose()
+
+
+@pytest.fixture(scope="session")
+def processed_sample_db(tmp_path_factory) -> str:
+    """The committed sample campaign processed once into a SQLite database (URL)."""
+    from swtlab_cli.main import main
+
+    url = f"sqlite:///{tmp_path_factory.mktemp('sample_db') / 'swtlab.sqlite'}"
+    campaign = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
+    assert main(["process", str(campaign), "--db", url, "--quiet"]) == 0
+    return url

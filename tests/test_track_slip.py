@@ -26,7 +26,7 @@ def _random_render(i: int):
     """Render ``i`` of the accuracy set: slips evenly over 0-0.8, seeded random nuisances."""
     rng = np.random.default_rng(10_000 + i)
     slip = 0.8 * i / 59
-    px_per_m = float(rng.uniform(600, 1100))
+    px_per_m = float(rng.uniform(600, 900))
     return render_track(slip, RADIUS_M, GROUSERS, HEIGHT_M, px_per_m, seed=i,
                         nuisance=random_nuisance(20_000 + i, SIZE_PX))
 
@@ -148,3 +148,11 @@ def test_bad_arguments():
                            scale_distance_m=0.1)
     with pytest.raises(ValueError):
         measure_track_slip(image[:10], RADIUS_M, GROUSERS, px_per_m=900.0)
+
+
+def test_slip_from_spacing_follows_the_spec_for_drive_and_skid():
+    from softflow.track_slip import slip_from_spacing
+
+    assert slip_from_spacing(0.75, 1.0) == (0.25, 0.0)
+    slip, std = slip_from_spacing(1.25, 1.0, 0.01)  # braked: (r*omega - v)/v
+    assert slip == pytest.approx(-0.2) and std == pytest.approx(0.008)

@@ -15,7 +15,8 @@ from virtual_testbed.track_render import write_track_render
 def track_png(tmp_path_factory):
     folder = tmp_path_factory.mktemp("track")
     png, truth_path = write_track_render(folder / "track.png", 0.55, px_per_m=850.0, seed=2,
-                                         size_px=(800, 600), track_angle_deg=130.0)
+                                         size_px=(800, 600), track_angle_deg=130.0,
+                                         sun_azimuth_deg=150.0)
     return png, json.loads(truth_path.read_text())
 
 

@@ -70,7 +70,8 @@ def random_nuisance(seed: int, size_px: tuple[int, int] = (640, 480)) -> TrackNu
         mark_depth_jitter=u(0.05, 0.3), mark_fade=u(0, 0.5), mark_position_jitter=u(0, 0.02),
         missing_fraction=u(0, 0.15), doubled_fraction=u(0, 0.1), smeared_fraction=u(0, 0.2),
         sand_roughness=u(0.5, 1.5), track_tone=u(0.85, 1.1), sun_elevation_deg=u(12, 40),
-        sun_azimuth_deg=track_deg + u(-50, 50) + 180 * rng.integers(2), contrast=u(0.5, 1.2), brightness=u(-30, 20),
+        sun_azimuth_deg=track_deg + u(-50, 50) + 180 * rng.integers(2),
+        contrast=u(0.5, 1.2), brightness=u(-30, 20),
         noise_std=u(1, 6), blur_px=u(0, 1.2), perspective=u(0, 0.015),
         perspective_azimuth_deg=u(0, 360))
 
@@ -106,8 +107,8 @@ def _along_profile(slip, radius_m, grouser_count, grouser_height_m, nz, half_len
     """Track surface height (m) along the track on a fine grid, and the true mark centres.
 
     Every grouser cuts the same groove (rigid wheel, steady sinkage); what the sand does
-    afterwards varies mark to mark: the relief about its one-pitch mean is scaled (fading, filled-in
-    marks), blurred (smeared marks) or gets a second, narrow re-bite (doubled marks).
+    afterwards varies mark to mark: the relief about its one-pitch mean is scaled (fading,
+    filled-in marks), blurred (smeared marks) or gets a second, narrow re-bite (doubled).
     """
     spacing_m = mark_spacing_m(slip, radius_m, grouser_count)
     rel_m, groove = groove_profile(slip, radius_m, grouser_height_m, nz.grouser_thickness_m)
@@ -156,6 +157,7 @@ def _fractal(shape, rng, sigmas_px, amplitudes):
 
 
 def _smoothstep(x):
+    """0 below -1, 1 above 1, smooth in between."""
     return np.clip(0.5 + 0.5 * x, 0, 1) ** 2 * (3 - 2 * np.clip(0.5 + 0.5 * x, 0, 1))
 
 
