@@ -12,8 +12,10 @@ import time
 from pathlib import Path
 
 import pandas as pd
+import pytest
 from sqlalchemy import func, select
 
+import ingest
 from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import ProcessingRecord, RawFile, RunQuantity, RunResult, StableWindow
@@ -25,7 +27,7 @@ QUANTITIES = ("slip", "travel_velocity_mps", "wheel_omega_radps", "wheel_load_n"
 
 def _small_campaign(tmp_path: Path, run_ids: list[str]) -> Path:
     campaign = tmp_path / "campaign"
-    campaign.mkdir()
+    campaign.mkdir(parents=True)
     for run_id in run_ids:
         source = SAMPLE / "campaign" / f"{run_id}.mcap"
         if source.exists():
@@ -107,3 +109,29 @@ def test_killed_batch_finishes_on_rerun_without_duplicates(tmp_path):
     with open_database(db_url)() as session:
         paths = session.scalars(select(RawFile.path)).all()
     assert len(set(paths)) == len(paths) == len(run_ids)
+
+
+def test_campaign_rig_compliance_is_applied_and_stored(tmp_path):
+    """A campaign's [rig_compliance] lifts the hub by m_per_n * (fz - ref): sinkage drops by it."""
+    run_id = "L300_MP0_SC_s+020"
+    plain = _small_campaign(tmp_path / "plain", [run_id])
+    compliant = _small_campaign(tmp_path / "compliant", [run_id])
+    (compliant / "swtlab.toml").write_text(
+        '[rig_compliance]\nkind = "linear"\nm_per_n = 1.0e-5\nreference_load_n = 0.0\n'
+        'source = "frame deflection test 2026-11"\n')
+    results = {}
+    for name, campaign in (("plain", plain), ("compliant", compliant)):
+        url = f"sqlite:///{tmp_path / name}.sqlite"
+        assert main(["process", str(campaign), "--db", url, "--quiet"]) == 0
+        with open_database(url)() as session:
+            result = session.scalars(select(RunResult)).one()
+            results[name] = ({q.quantity: q.mean for q in result.quantities},
+                             result.corrections)
+    (plain_q, plain_c), (comp_q, comp_c) = results["plain"], results["compliant"]
+    assert comp_c["rig_compliance"]["m_per_n"] == 1.0e-5
+    assert comp_c["rig_compliance"]["source"] == "frame deflection test 2026-11"
+    expected_shift_m = 1.0e-5 * comp_q["wheel_load_n"]  # about 3 mm at 300 N
+    assert plain_q["sinkage_m"] - comp_q["sinkage_m"] == pytest.approx(expected_shift_m, rel=0.02)
+    assert comp_c["hub_height_correction_mean_m"] == pytest.approx(expected_shift_m, rel=0.01)
+    truth_zero = ingest.read_run(compliant / f"{run_id}.mcap").metadata.zero
+    assert comp_c["tare"]["zero_offsets_subtracted"] == pytest.approx(truth_zero)
