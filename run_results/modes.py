@@ -8,16 +8,28 @@ to 15 N by multipass 2).
 
 from __future__ import annotations
 
-from collections import defaultdict
-
 import numpy as np
+import pandas as pd
 
 from run_results.result import RunResult
 
 
-def _group_key(result: RunResult) -> tuple:
-    c = result.condition
-    return (c.get("wheel"), c.get("soil"), c.get("multipass"), c.get("load_n"))
+GROUP = ["wheel", "soil", "multipass", "load_set_n"]
+
+
+def results_table(results: list[RunResult]) -> pd.DataFrame:
+    """Run results as the one-row-per-run table of ``swtlab results`` (docs/results.md
+    columns: conditions, ``status``, ``<quantity>_mean|_std|_se``), for code without a database."""
+    rows = []
+    for r in results:
+        c = r.condition
+        row = {"run_id": r.run_id, "mode": r.mode, "status": r.status, "wheel": c.get("wheel"),
+               "soil": c.get("soil"), "multipass": c.get("multipass"),
+               "load_set_n": c.get("load_n"), "slip_setpoint": c.get("slip_setpoint")}
+        for name, q in r.quantities.items():
+            row.update({f"{name}_mean": q.mean, f"{name}_std": q.std, f"{name}_se": q.se})
+        rows.append(row)
+    return pd.DataFrame.from_records(rows)
 
 
 def resistance_at_zero_slip(slip: np.ndarray, resistance_n: np.ndarray,
@@ -42,40 +54,38 @@ def resistance_at_zero_slip(slip: np.ndarray, resistance_n: np.ndarray,
     return float((1 - w) * r[i] + w * r[j]), float(np.hypot((1 - w) * e[i], w * e[j])), how
 
 
-def towed_vs_powered(results: list[RunResult], max_abs_slip: float = 0.15) -> list[dict]:
+def towed_vs_powered(table: pd.DataFrame, max_abs_slip: float = 0.15) -> list[dict]:
     """Per (wheel, soil, multipass, load): towed ``R`` against powered ``R`` at slip 0.
 
+    ``table``: one row per run as ``swtlab results`` lists it (or :func:`results_table`).
     Powered ``R`` at slip 0 comes from the speed-control runs with ``|slip| <= max_abs_slip``
     (``resistance_at_zero_slip``).
     """
-    towed, powered = defaultdict(list), defaultdict(list)
-    for r in results:
-        if r.status == "no_stable_phase" or "resistance_n" not in r.quantities:
-            continue
-        if r.mode == "towed":
-            towed[_group_key(r)].append(r)
-        elif r.mode == "speed_control" and abs(r.quantities["slip"].mean) <= max_abs_slip:
-            powered[_group_key(r)].append(r)
+    if table.empty or "resistance_n_mean" not in table:
+        return []
+    usable = table[(table["status"] != "no_stable_phase") & table["resistance_n_mean"].notna()]
+    towed = usable[usable["mode"] == "towed"]
+    powered = usable[(usable["mode"] == "speed_control")
+                     & (usable["slip_mean"].abs() <= max_abs_slip)]
     rows = []
-    for key in sorted(towed, key=str):
+    for key, runs in towed.groupby(GROUP, sort=True):
         wheel, soil, multipass, load_n = key
-        t_r = np.array([r.quantities["resistance_n"].mean for r in towed[key]])
-        t_se = np.array([r.quantities["resistance_n"].se for r in towed[key]])
-        row = {"wheel": wheel, "soil": soil, "multipass": multipass, "load_n": load_n,
-               "towed_runs": [r.run_id for r in towed[key]],
-               "towed_resistance_n": float(t_r.mean()),
-               "towed_resistance_se_n": float(np.sqrt(np.sum(t_se ** 2)) / t_se.size),
-               "towed_slip": float(np.mean([r.quantities["slip"].mean for r in towed[key]])),
-               "powered_runs": [r.run_id for r in powered.get(key, [])],
-               "powered_resistance_at_zero_slip_n": None, "powered_resistance_se_n": None,
-               "powered_method": None, "difference_n": None, "max_abs_slip": max_abs_slip}
-        runs = powered.get(key, [])
-        if runs:
-            slip = np.array([r.quantities["slip"].mean for r in runs])
-            res = np.array([r.quantities["resistance_n"].mean for r in runs])
-            se = np.array([r.quantities["resistance_n"].se for r in runs])
-            r0, r0_se, how = resistance_at_zero_slip(slip, res, se)
-            row.update(powered_resistance_at_zero_slip_n=r0, powered_resistance_se_n=r0_se,
-                       powered_method=how, difference_n=row["towed_resistance_n"] - r0)
+        se = runs["resistance_n_se"].to_numpy(float)
+        row = {"wheel": wheel, "soil": soil, "multipass": int(multipass), "load_n": float(load_n),
+               "towed_runs": list(runs["run_id"]),
+               "towed_resistance_n": float(runs["resistance_n_mean"].mean()),
+               "towed_resistance_se_n": float(np.sqrt(np.sum(se ** 2)) / se.size),
+               "towed_slip": float(runs["slip_mean"].mean()),
+               "powered_runs": [], "powered_resistance_at_zero_slip_n": None,
+               "powered_resistance_se_n": None, "powered_method": None, "difference_n": None,
+               "max_abs_slip": max_abs_slip}
+        same = powered[(powered[GROUP] == pd.Series(key, index=GROUP)).all(axis=1)]
+        if len(same):
+            r0, r0_se, how = resistance_at_zero_slip(same["slip_mean"].to_numpy(float),
+                                                     same["resistance_n_mean"].to_numpy(float),
+                                                     same["resistance_n_se"].to_numpy(float))
+            row.update(powered_runs=list(same["run_id"]), powered_resistance_at_zero_slip_n=r0,
+                       powered_resistance_se_n=r0_se, powered_method=how,
+                       difference_n=row["towed_resistance_n"] - r0)
         rows.append(row)
     return rows

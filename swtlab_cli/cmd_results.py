@@ -6,11 +6,17 @@ import argparse
 import sys
 from pathlib import Path
 
+import pandas as pd
+
 from swtlab_cli import exit_codes
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
                    "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
                    "torque_nm_mean", "sinkage_m_mean", "resistance_n_mean"]
+
+TOWED_COLUMNS = ["wheel", "soil", "multipass", "load_n", "towed_resistance_n",
+                 "towed_resistance_se_n", "powered_resistance_at_zero_slip_n",
+                 "powered_resistance_se_n", "powered_method", "difference_n"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,6 +29,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")
     out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
+    parser.add_argument("--towed", action="store_true",
+                        help="instead: motion resistance of the towed runs against powered runs "
+                             "at zero slip, per wheel, soil, multipass and load")
     parser.set_defaults(func=run)
 
 
@@ -36,11 +45,20 @@ def run(args: argparse.Namespace) -> int:
         print(f"swtlab results: {args.db}: no processed runs (run swtlab process first)",
               file=sys.stderr)
         return exit_codes.BAD_INPUT
+    if args.towed:
+        from run_results import towed_vs_powered
+
+        table = pd.DataFrame(towed_vs_powered(table))
+        if table.empty:
+            print(f"swtlab results: {args.db}: no towed runs", file=sys.stderr)
+            return exit_codes.BAD_INPUT
     if args.csv:
         table.to_csv(args.csv, index=False)
         print(f"{len(table)} runs written to {args.csv}")
     elif args.json:
         print(table.to_json(orient="records", indent=1))
+    elif args.towed:
+        print(table[TOWED_COLUMNS].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     else:
         columns = [c for c in SUMMARY_COLUMNS if c in table.columns]
         print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))

@@ -44,11 +44,11 @@ def _counts(db_url: str) -> dict[str, int]:
 
 
 def test_results_table_has_one_row_per_run_with_the_truth(tmp_path, db_url, capsys):
-    run_ids = ["L180_MP0_SC_s+020", "L180_MP0_SC_s+090", "L180_MP0_TW"]
+    run_ids = ["L180_MP0_SC_s+020", "L180_MP0_SC_s+090", "L180_MP0_TW", "L180_MP0_SC_s+000"]
     campaign = _small_campaign(tmp_path, run_ids)
     assert main(["process", str(campaign), "--db", db_url, "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "processed 3 of 3 runs" in out and "without a stable phase" in out
+    assert "processed 4 of 4 runs" in out and "without a stable phase" in out
     assert main(["results", "--db", db_url, "--json"]) == 0
     table = pd.DataFrame(json.loads(capsys.readouterr().out)).set_index("run_id")
     assert sorted(table.index) == sorted(run_ids)
@@ -66,7 +66,15 @@ def test_results_table_has_one_row_per_run_with_the_truth(tmp_path, db_url, caps
         assert abs(row["slip_mean"] - means["slip"]) < 2e-3
     csv_path = tmp_path / "results.csv"
     assert main(["results", "--db", db_url, "--csv", str(csv_path)]) == 0
-    assert len(pd.read_csv(csv_path)) == 3
+    assert len(pd.read_csv(csv_path)) == len(run_ids)
+    capsys.readouterr()
+    # towed R against powered R near zero slip (BB2 model at 180 N: about 18 N)
+    assert main(["results", "--db", db_url, "--towed", "--json"]) == 0
+    (towed,) = json.loads(capsys.readouterr().out)
+    assert towed["load_n"] == 180.0 and towed["towed_runs"] == ["L180_MP0_TW"]
+    assert towed["powered_runs"] == ["L180_MP0_SC_s+000"]
+    assert towed["towed_resistance_n"] == pytest.approx(18.0, abs=1.5)
+    assert abs(towed["difference_n"]) < 1.5
 
 
 def test_reprocessing_changes_nothing(tmp_path, db_url):

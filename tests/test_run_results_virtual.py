@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import ingest
-from run_results import RigCompliance, process_run, towed_vs_powered
+from run_results import RigCompliance, process_run, results_table, towed_vs_powered
 from virtual_testbed import Rates, RunCondition, SensorModel, generate_campaign
 from virtual_testbed import Testbed as VirtualTestbed
 from virtual_testbed.grousers import oscillation_shape
@@ -214,7 +214,7 @@ def test_towed_resistance_against_powered_runs_near_zero_slip(tmp_path):
         truth = json.loads((tmp_path / "truth" / f"{c.run_id}.json").read_text())
         truths[c.run_id] = truth
         results.append(process_run(ingest.read_run(tmp_path / truth["raw_file"])))
-    rows = {row["multipass"]: row for row in towed_vs_powered(results)}
+    rows = {row["multipass"]: row for row in towed_vs_powered(results_table(results))}
     assert sorted(rows) == [0, 1, 2]
     for mp, row in rows.items():
         assert len(row["powered_runs"]) == 5 and row["towed_runs"] == [f"L180_MP{mp}_TW"]
