@@ -1,6 +1,7 @@
 """Per-run results with honest uncertainty, for every test mode (docs/run-results.md).
 
-Pure functions: ``process_run(run) -> RunResult``; ``towed_vs_powered(results_table(results))``. Never
+Pure functions: ``process_run(run) -> RunResult``;
+``towed_vs_powered(results_table(results))``. Never
 reads ground truth.
 """
 

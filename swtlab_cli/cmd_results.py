@@ -1,4 +1,4 @@
-"""``swtlab results --db URL [--csv FILE | --json]``: one row per run (columns in docs/results.md)."""
+"""``swtlab results --db URL [--csv FILE | --json]``: one row per run (docs/results.md)."""
 
 from __future__ import annotations
 

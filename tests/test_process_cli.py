@@ -1,4 +1,4 @@
-"""swtlab process / results end to end: one row per run, and a batch killed midway finishes cleanly."""
+"""swtlab process / results end to end: one row per run; a batch killed midway finishes cleanly."""
 
 from __future__ import annotations
 
@@ -135,7 +135,7 @@ def test_campaign_rig_compliance_is_applied_and_stored(tmp_path):
             result = session.scalars(select(RunResult)).one()
             results[name] = ({q.quantity: q.mean for q in result.quantities},
                              result.corrections)
-    (plain_q, plain_c), (comp_q, comp_c) = results["plain"], results["compliant"]
+    (plain_q, _), (comp_q, comp_c) = results["plain"], results["compliant"]
     assert comp_c["rig_compliance"]["m_per_n"] == 1.0e-5
     assert comp_c["rig_compliance"]["source"] == "frame deflection test 2026-11"
     expected_shift_m = 1.0e-5 * comp_q["wheel_load_n"]  # about 3 mm at 300 N

@@ -11,7 +11,6 @@ window holds whole periods. "1 %" is of the quantity's scale: the wheel load for
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -170,7 +169,7 @@ def test_no_stable_phase_runs_keep_their_dp_trace(processed):
 
 
 def test_status_flags_tare_and_json(processed):
-    for truth, run, result in processed:
+    for truth, _run, result in processed:
         assert result.corrections["tare"]["zero_offsets_subtracted"] == truth["measurement"]["zero"]
         assert result.corrections["rig_compliance"] is None
         assert result.condition["load_n"] == truth["condition"]["load_n"]
@@ -229,21 +228,16 @@ def test_towed_resistance_against_powered_runs_near_zero_slip(tmp_path):
     assert r0[2] < r0[0]
 
 
-def test_steered_run_reports_side_force_and_slip_angle(processed):
-    """The testbed has no steered mode yet: a speed-control run relabelled steered (10 deg)
-    with a known side force written into fy_n."""
-    truth, run, _ = next(p for p in processed if p[0]["run_id"] == "sc03")
-    info = replace(run.metadata.run, mode="steered", steer_deg=10.0)
-    rng = np.random.default_rng(0)
-    channels = run.channels.copy()
-    channels["fy_n"] = -25.0 + rng.normal(0.0, 0.4, len(channels))
-    wrench = run.streams["/hub/wrench"].copy()
-    wrench["fy_n"] = -25.0 + rng.normal(0.0, 0.4, len(wrench))
-    steered = replace(run, metadata=replace(run.metadata, run=info), channels=channels,
-                      streams={**run.streams, "/hub/wrench": wrench})
-    result = process_run(steered)
+def test_steered_run_reports_side_force_and_slip_angle(tmp_path):
+    """A steered testbed run (10 deg slip angle): side force and slip angle against the truth."""
+    condition = RunCondition("ST10", "steered", 180.0, 0, 0.2, steer_deg=10.0)
+    generate_campaign(tmp_path, [condition], seed=3, rates=RATES)
+    truth = json.loads((tmp_path / "truth" / "ST10.json").read_text())
+    result = process_run(ingest.read_run(tmp_path / truth["raw_file"]))
     assert result.mode == "steered" and result.window.found
-    side = result.quantities["side_force_n"]
-    assert side.mean == pytest.approx(-25.0, abs=3 * side.se) and side.se < 0.05
-    assert result.quantities["slip_angle_deg"].mean == 10.0
+    side, means = result.quantities["side_force_n"], truth["stable_means"]
+    assert means["side_force_n"] > 0.2 * 180.0  # the testbed's saturating side-force law
+    assert side.mean == pytest.approx(means["side_force_n"], abs=max(3 * side.se, 0.01 * 180.0))
+    assert result.quantities["slip_angle_deg"].mean == means["slip_angle_deg"] == 10.0
+    assert result.quantities["slip"].mean == pytest.approx(0.2, abs=0.005)
     assert result.condition["steer_deg"] == 10.0

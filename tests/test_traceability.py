@@ -1,4 +1,4 @@
-"""Traceability database: raw-file versions, idempotent re-ingest, batches that go on past bad runs."""
+"""Traceability database: raw-file versions, idempotent re-ingest, batches past bad runs."""
 
 from __future__ import annotations
 

@@ -86,16 +86,17 @@ def _sha256_tree(path: Path) -> dict[str, str]:
 
 def test_sample_contents_and_size():
     conditions = sample_conditions()
-    assert len(conditions) == len(TRUTHS) == 59
+    assert len(conditions) == len(TRUTHS) == 60
     modes = [t["condition"]["mode"] for t in TRUTHS.values()]
     assert modes.count("towed") == 3 and modes.count("free_sled") == 3
+    assert modes.count("steered") == 1
     series = {(t["condition"]["load_n"], t["condition"]["multipass"]) for t in TRUTHS.values()
               if t["condition"]["mode"] == "speed_control"}
     assert series == {(70.0, 0), (70.0, 1), (180.0, 0), (180.0, 1), (300.0, 0), (300.0, 1),
                       (120.0, 0)}
     slips = sorted(t["condition"]["slip_setpoint"] for t in TRUTHS.values()
-                   if (t["condition"]["mode"], t["condition"]["load_n"], t["condition"]["multipass"])
-                   == ("speed_control", 180.0, 0))
+                   if (t["condition"]["mode"], t["condition"]["load_n"],
+                       t["condition"]["multipass"]) == ("speed_control", 180.0, 0))
     assert len(slips) == 8 and slips[0] == -0.10 and slips[-1] == 0.90
     forms = {t["form"] for t in TRUTHS.values()}
     assert forms == {"mcap", "csv"}
@@ -136,8 +137,11 @@ def test_mcap_runs_follow_the_spec(run_id):
     assert {"swt.run", "swt.wheel", "swt.suspension", "swt.zero"} <= set(metadata)
     assert all(isinstance(v, str) for rec in metadata.values() for v in rec.values())
     run = metadata["swt.run"]
-    assert set(run) == RUN_KEYS | {"slip_setpoint"}
-    assert run["mode"] == "speed_control" and int(run["multipass"]) in (0, 1)
+    steered = run["mode"] == "steered"
+    assert set(run) == RUN_KEYS | {"slip_setpoint"} | ({"steer_deg"} if steered else set())
+    assert run["mode"] in ("speed_control", "steered") and int(run["multipass"]) in (0, 1)
+    if steered:
+        assert float(run["steer_deg"]) == TRUTHS[run_id]["condition"]["steer_deg"] == 10.0
     assert float(run["slip_setpoint"]) == TRUTHS[run_id]["condition"]["slip_setpoint"]
     assert metadata["swt.wheel"] == {"radius_m": "0.125", "width_m": "0.112", "grouser_count": "12",
                                      "grouser_height_m": "0.0092", "stiffness_N_per_mm": "30.0"}
@@ -232,7 +236,7 @@ def test_stable_means_match_the_law():
 def test_no_stable_phase_runs_are_marked_and_collapse():
     digging = {r: t for r, t in TRUTHS.items() if t["stable_window"] is None}
     assert sorted(digging) == ["L180_MP0_SC_s+090", "L300_MP0_SC_s+090", "L300_MP1_SC_s+090"]
-    for run_id, truth in digging.items():
+    for truth in digging.values():
         assert truth["stable_means"] is None and "dig-in" in truth["no_stable_phase_reason"]
         dig = truth["dig_in"]
         assert dig["dp_trend_end_n"] < 0.7 * dig["dp_trend_peak_n"]

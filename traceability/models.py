@@ -130,7 +130,7 @@ class Calibration(Base):
 
 
 class IngestFailure(Base):
-    """A file that could not be read, with the one-line reason (kept so a batch report can list it)."""
+    """A file that could not be read, with its one-line reason (a batch report lists it)."""
 
     __tablename__ = "ingest_failure"
     id: Mapped[int] = mapped_column(primary_key=True)

@@ -1,4 +1,4 @@
-"""Read-back: one row per run with its conditions, stable window and results (``swtlab results``)."""
+"""Read-back: one row per run with conditions, stable window and results (swtlab results)."""
 
 from __future__ import annotations
 

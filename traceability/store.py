@@ -27,7 +27,8 @@ class StoreOutcome(enum.Enum):
     UNCHANGED = "unchanged"
 
 
-def new_processing_record(session: Session, stage: str, parameters: dict[str, Any]) -> ProcessingRecord:
+def new_processing_record(session: Session, stage: str,
+                          parameters: dict[str, Any]) -> ProcessingRecord:
     record = ProcessingRecord(swtlab_version=version("swtlab"), stage=stage,
                               parameters=json.loads(json.dumps(parameters, default=str)),
                               created_at=datetime.now(timezone.utc))
@@ -77,7 +78,8 @@ def _file_format(run: Any) -> str:
 
 def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, Any],
                        parameters: dict[str, Any]) -> tuple[RawFile, StoreOutcome]:
-    """Record ``run`` (an ``ingest.Run``) and its raw file; return the raw-file row and what changed.
+    """Record ``run`` (an ``ingest.Run``) and its raw file; return the raw-file row and the
+    outcome.
 
     ``parameters`` (channel map, derivation methods) go into the processing record
     written with a new raw-file version; an unchanged file writes nothing.

@@ -36,7 +36,7 @@ def processed_file(session: Session, path: Path, sha256: str, params_hash: str) 
 
 def store_run_result(session: Session, raw_file: RawFile, result: Any,
                      parameters: dict[str, Any]) -> RunResult:
-    """Store ``result`` (a ``run_results.RunResult``) with its window under one processing record."""
+    """Store ``result`` (a ``run_results.RunResult``) and its window, one processing record."""
     record = new_processing_record(session, "process", parameters)
     w = result.window
     window = StableWindow(raw_file_id=raw_file.id, found=w.found, start_s=w.start_s,
@@ -44,7 +44,8 @@ def store_run_result(session: Session, raw_file: RawFile, result: Any,
                           diagnostics=jsonable(w.diagnostics), reason=w.reason, processing=record)
     row = RunResult(raw_file=raw_file, window=window, params_sha256=params_sha256(parameters),
                     status=result.status, flags=list(result.flags),
-                    oscillation=jsonable(result.oscillation), corrections=jsonable(result.corrections),
+                    oscillation=jsonable(result.oscillation),
+                    corrections=jsonable(result.corrections),
                     dp_trace=jsonable(result.dp_trace), processing=record,
                     quantities=[RunQuantity(quantity=name, unit=q.unit, mean=_num(q.mean),
                                             std=_num(q.std), se=_num(q.se), n=q.n,

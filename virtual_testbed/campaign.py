@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from virtual_testbed.conditions import RunCondition
+from virtual_testbed.lateral import LateralLaw
 from virtual_testbed.law import PerformanceLaw, bb2_sand_law
 from virtual_testbed.measure import RawRun, measure
 from virtual_testbed.rig import BB2_WHEEL, Suspension, Timeline, Wheel
@@ -29,6 +30,7 @@ class Testbed:
     """Everything fixed across a campaign: the law, the rig, the sensors and the run timeline."""
 
     law: PerformanceLaw = field(default_factory=bb2_sand_law)
+    lateral: LateralLaw = LateralLaw()
     wheel: Wheel = BB2_WHEEL
     suspension: Suspension = Suspension()
     timeline: Timeline = Timeline()
@@ -58,6 +60,8 @@ def run_metadata(condition: RunCondition, testbed: Testbed, start: str) -> dict[
            "multipass": c.multipass, "mode": c.mode, "load_N": float(c.load_n)}
     if c.slip_setpoint is not None:
         run["slip_setpoint"] = float(c.slip_setpoint)
+    if c.steer_deg is not None:
+        run["steer_deg"] = float(c.steer_deg)
     run.update({"velocity_mps": float(c.velocity_mps), "gravity_mps2": float(c.gravity_mps2),
                 "started_at": start})
     wheel = {"radius_m": w.radius_m, "width_m": w.width_m, "grouser_count": w.grouser_count,
@@ -77,7 +81,8 @@ def make_run(condition: RunCondition, seed: int, start: str, testbed: Testbed,
     rng = run_rng(seed, condition.run_id)
     tb = testbed
     true_run = simulate_true_run(condition, tb.law, tb.wheel, tb.timeline, tb.dynamics,
-                                 phase_rad=float(rng.uniform(0.0, 2.0 * np.pi)))
+                                 phase_rad=float(rng.uniform(0.0, 2.0 * np.pi)),
+                                 lateral=tb.lateral)
     measurement = measure(true_run, tb.wheel, tb.suspension, tb.rates, tb.sensors, rng,
                           run_metadata(condition, tb, start))
     truth = truth_record(true_run, radius_m=tb.wheel.radius_m, grouser_count=tb.wheel.grouser_count,

@@ -6,14 +6,17 @@ from dataclasses import dataclass
 
 from virtual_testbed.law import STANDARD_GRAVITY_MPS2
 
-MODES = ("speed_control", "free_sled", "towed")
+MODES = ("speed_control", "free_sled", "towed", "steered")
+#: modes whose slip the testbed imposes through the wheel and sled speeds
+SLIP_IMPOSED = ("speed_control", "steered")
 #: 40 m/h, the travel velocity of the ESA/ExoMars SWT campaigns.
 VELOCITY_40_M_PER_H_MPS = 40.0 / 3600.0
 
 
 @dataclass(frozen=True)
 class RunCondition:
-    """One run: what the testbed operator sets (``slip_setpoint`` only for speed control)."""
+    """One run: what the testbed operator sets (``slip_setpoint`` for speed control and steered
+    runs, ``steer_deg``, the slip angle of the wheel to the travel direction, for steered runs)."""
 
     run_id: str
     mode: str
@@ -22,11 +25,15 @@ class RunCondition:
     slip_setpoint: float | None = None
     velocity_mps: float = VELOCITY_40_M_PER_H_MPS
     gravity_mps2: float = STANDARD_GRAVITY_MPS2
+    steer_deg: float | None = None
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
             raise ValueError(f"mode {self.mode!r} not in {MODES}")
-        if (self.mode == "speed_control") != (self.slip_setpoint is not None):
-            raise ValueError("slip_setpoint is required for speed_control and only there")
+        if (self.mode in SLIP_IMPOSED) != (self.slip_setpoint is not None):
+            raise ValueError("slip_setpoint is required for speed_control and steered, and only "
+                             "there")
+        if (self.mode == "steered") != (self.steer_deg is not None):
+            raise ValueError("steer_deg is required for steered runs and only there")
         if self.slip_setpoint is not None and not -1.0 < self.slip_setpoint < 1.0:
             raise ValueError(f"slip_setpoint {self.slip_setpoint} outside (-1, 1)")

@@ -80,7 +80,7 @@ class _Sensing:
 
 def _wrench(ctx: _Sensing, t):
     s, zero, spikes = ctx.sensors, ctx.zero, ctx.spikes
-    true = {"fx": ctx.true_at(t, "fx_n") + spikes.at(t, "fx_n"), "fy": 0.0,
+    true = {"fx": ctx.true_at(t, "fx_n") + spikes.at(t, "fx_n"), "fy": ctx.true_at(t, "fy_n"),
             "fz": ctx.true_at(t, "fz_n") + spikes.at(t, "fz_n"), "tx": 0.0,
             "ty": ctx.true_at(t, "torque_nm") + spikes.at(t, "ty_nm"), "tz": 0.0}
     out = {}

@@ -6,7 +6,8 @@ rewrites ``sample_data/`` bit for bit. Contents (see docs/virtual-testbed.md):
 - speed control, loads 70/180/300 N, multipass 0 and 1, 8 slips from -10 % to
   90 % each (MCAP form);
 - a 120 N validation series, multipass 0, 5 slips between the others (MCAP form);
-- one towed and one free-sled run per load, multipass 0 (CSV form).
+- one towed and one free-sled run per load, multipass 0 (CSV form);
+- one steered run, 180 N, slip 0.2 at a 10 degree slip angle (MCAP form).
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ SAMPLE_TESTBED = Testbed(campaign="bb2_sand_sample", soil="ES-3-like sand", rate
 
 def run_id(load_n: float, multipass: int, mode: str, slip: float | None = None) -> str:
     """``L180_MP0_SC_s+020``: load, multipass, mode tag and slip in percent."""
-    tag = {"speed_control": "SC", "free_sled": "FS", "towed": "TW"}[mode]
+    tag = {"speed_control": "SC", "free_sled": "FS", "towed": "TW", "steered": "ST"}[mode]
     slip_tag = "" if slip is None else f"_s{round(slip * 100):+04d}"
     return f"L{load_n:03.0f}_MP{multipass}_{tag}{slip_tag}"
 
@@ -52,6 +53,8 @@ def sample_conditions() -> list[tuple[RunCondition, str]]:
     for load in LOADS_N:
         runs += [(RunCondition(run_id(load, 0, mode), mode, load, 0), "csv")
                  for mode in ("towed", "free_sled")]
+    runs.append((RunCondition(run_id(180.0, 0, "steered", 0.2) + "_b10", "steered", 180.0, 0, 0.2,
+                              steer_deg=10.0), "mcap"))
     return runs
 
 

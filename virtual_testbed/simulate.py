@@ -22,7 +22,8 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 from virtual_testbed import grousers
-from virtual_testbed.conditions import RunCondition
+from virtual_testbed.conditions import SLIP_IMPOSED, RunCondition
+from virtual_testbed.lateral import DEFAULT_LATERAL, LateralLaw
 from virtual_testbed.law import PerformanceLaw, self_propelled_slip, towed_slip
 from virtual_testbed.rig import Timeline, Wheel
 
@@ -67,7 +68,7 @@ class TrueRun:
 
 def steady_slip(condition: RunCondition, law: PerformanceLaw) -> float:
     """Slip the run settles at: the set point, or where DP = 0 (free sled) or torque = 0 (towed)."""
-    if condition.mode == "speed_control":
+    if condition.mode in SLIP_IMPOSED:
         return float(condition.slip_setpoint)
     solver = self_propelled_slip if condition.mode == "free_sled" else towed_slip
     return solver(law, condition.load_n, condition.multipass, condition.gravity_mps2)
@@ -109,8 +110,10 @@ def _kinematics(c: RunCondition, slip_ss: float, speed, settle, radius_m: float,
 
 
 def simulate_true_run(condition: RunCondition, law: PerformanceLaw, wheel: Wheel,
-                      timeline: Timeline, dynamics: Dynamics, phase_rad: float = 0.0) -> TrueRun:
-    """Noise-free signals of one run on a uniform grid at ``dynamics.grid_hz``."""
+                      timeline: Timeline, dynamics: Dynamics, phase_rad: float = 0.0,
+                      lateral: LateralLaw = DEFAULT_LATERAL) -> TrueRun:
+    """Noise-free signals of one run on a uniform grid at ``dynamics.grid_hz``; a steered
+    run also builds the side force of ``lateral`` at its slip angle."""
     c, tl, dyn = condition, timeline, dynamics
     if not np.isclose(law.radius_m, wheel.radius_m):
         raise ValueError(f"law radius {law.radius_m} m is not the wheel's {wheel.radius_m} m")
@@ -134,7 +137,7 @@ def simulate_true_run(condition: RunCondition, law: PerformanceLaw, wheel: Wheel
     sled_position = cumulative_trapezoid(velocity, t, initial=0.0)
 
     dig_in_slip = dyn.dig_in_slip(c.load_n, c.multipass)
-    digs_in = c.mode == "speed_control" and slip_ss >= dig_in_slip
+    digs_in = c.mode in SLIP_IMPOSED and slip_ss >= dig_in_slip
     dig_start_s = tl.motion_start_s + dyn.dig_delay_s
     dig_s = np.clip(np.minimum(t, tl.decel_start_s) - dig_start_s, 0.0, None)
     dig_m = dyn.dig_rate_per_s * z_ss * dig_s if digs_in else 0.0
@@ -159,6 +162,7 @@ def simulate_true_run(condition: RunCondition, law: PerformanceLaw, wheel: Wheel
         "slip": slip,
         "fz_n": w + dyn.fz_oscillation_ratio * w * osc_fz,
         "fx_n": fx,
+        "fy_n": float(lateral.side_force_n(w, c.steer_deg or 0.0)) * shear,
         "dp_trend_n": thrust - resistance,
         "dp_n": np.zeros_like(t) if c.mode == "free_sled" else fx,
         "torque_nm": (thrust + dyn.torque_oscillation_ratio * w * osc) * wheel.radius_m,

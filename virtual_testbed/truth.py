@@ -26,6 +26,8 @@ def stable_means(true_run: TrueRun, radius_m: float, start_s: float,
         return float(np.mean(sig[key][window]))
 
     thrust_n = mean("torque_nm") / radius_m
+    steered = {} if true_run.condition.mode != "steered" else {
+        "side_force_n": mean("fy_n"), "slip_angle_deg": float(true_run.condition.steer_deg)}
     return {
         "slip": mean("slip"),
         "travel_velocity_mps": mean("velocity_mps"),
@@ -36,6 +38,7 @@ def stable_means(true_run: TrueRun, radius_m: float, start_s: float,
         "thrust_n": thrust_n,
         "motion_resistance_n": thrust_n - mean("dp_n"),
         "sinkage_m": mean("sinkage_m"),
+        **steered,
     }
 
 
