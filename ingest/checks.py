@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from ingest.errors import IngestError
 from ingest.raw import RawTopic
@@ -37,3 +38,15 @@ def check_topic(path: Path, topic: str, raw: RawTopic) -> None:
             first = int(np.argmax(bad))
             raise IngestError(path, f"{topic}.{name}", f"{int(bad.sum())} NaN/inf samples, first "
                               f"at t={t[first]:.6f} s; fix or drop them at the source")
+
+
+def numeric_column(path: Path, frame: pd.DataFrame, column: str, first_row: int) -> np.ndarray:
+    """A text-table column as float64; a non-numeric cell is an IngestError naming the first
+    one (``first_row``: the file's line number of the frame's first data row)."""
+    values = pd.to_numeric(frame[column], errors="coerce").to_numpy(np.float64)
+    bad = np.isnan(values) & frame[column].notna().to_numpy()
+    if bad.any():
+        row = int(np.argmax(bad))
+        raise IngestError(path, column, f"{int(bad.sum())} non-numeric values, first in line "
+                          f"{row + first_row}: {frame[column].iloc[row]!r}")
+    return values

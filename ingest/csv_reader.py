@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ingest.channel_map import ChannelMap
+from ingest.checks import numeric_column
 from ingest.errors import IngestError
 from ingest.raw import FrameIndex, RawRun, RawTopic
 
@@ -62,13 +63,7 @@ def _read_topic(path: Path, cmap: ChannelMap, fields: dict[str, str]) -> RawTopi
     for column, name in wanted.items():
         if column not in frame.columns:
             continue
-        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(np.float64)
-        bad = np.isnan(values) & frame[column].notna().to_numpy()
-        if bad.any():
-            row = int(np.argmax(bad))
-            raise IngestError(path, column, f"{int(bad.sum())} non-numeric values, first in "
-                              f"data row {row + 1}: {frame[column].iloc[row]!r}")
-        out[name] = values
+        out[name] = numeric_column(path, frame, column, first_row=2)  # after the header
     t = out.pop("t") * cmap.time_scale_s
     return RawTopic(t_s=t, fields=out)
 

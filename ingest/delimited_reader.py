@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from ingest.channel_map import ChannelMap
+from ingest.checks import numeric_column
 from ingest.errors import IngestError
 from ingest.raw import RawRun, RawTopic
 
@@ -33,13 +33,7 @@ def read_delimited(path: Path, cmap: ChannelMap) -> RawRun:
     for name in cmap.columns:
         if name not in wanted:
             continue
-        values = pd.to_numeric(frame[name], errors="coerce").to_numpy(np.float64)
-        bad = np.isnan(values) & frame[name].notna().to_numpy()
-        if bad.any():
-            row = int(np.argmax(bad))
-            raise IngestError(path, name, f"{int(bad.sum())} non-numeric values, first in row "
-                              f"{row + 1 + cmap.header_rows}: {frame[name].iloc[row]!r}")
-        fields[name] = values
+        fields[name] = numeric_column(path, frame, name, first_row=1 + cmap.header_rows)
     t = fields.pop(cmap.time_column)
     t_s = (t - t[0]) * cmap.time_scale_s if len(t) else t
     return RawRun(path=path, records={}, topics={cmap.stream: RawTopic(t_s=t_s, fields=fields)})

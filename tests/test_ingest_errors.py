@@ -180,7 +180,7 @@ def test_csv_form_errors(tmp_path, ingest_tools, ingest_spec):
     text[5] = text[5].split(",")[0] + ",abc"
     (folder / "tether_force.csv").write_text("\n".join(text))
     err = _error(folder)
-    assert err.channel == "dp" and "1 non-numeric values, first in data row 5: 'abc'" in err.problem
+    assert err.channel == "dp" and "1 non-numeric values, first in line 6: 'abc'" in err.problem
     folder = ingest_tools.write_csv_run(tmp_path / "run3", ingest_spec.topics, ingest_spec.records)
     text = (folder / "sled_encoder.csv").read_text().replace("t_s,", "time,", 1)
     (folder / "sled_encoder.csv").write_text(text)
