@@ -92,7 +92,7 @@ def _harmonics(profile: np.ndarray, period: float, count: int) -> np.ndarray:
     h = np.arange(1, count + 1)
     arg = 2 * np.pi * np.outer(a, h) / period
     design = np.hstack([np.cos(arg), np.sin(arg), np.ones((a.size, 1))])
-    coef = np.linalg.lstsq(design, profile, rcond=None)[0]
+    coef = np.linalg.solve(design.T @ design, design.T @ profile)
     return coef[:count] - 1j * coef[count:2 * count]
 
 

@@ -5,12 +5,14 @@ of the image's power spectrum whose frequency vector points along the track
 (Fourier slice theorem: that peak is the periodicity of the projection along the
 stripes). Candidates come from the spectrum whitened by its radial mean (sand is
 isotropic); the strip is the band of image rows along that direction whose mean,
-demodulated at that frequency, carries the pattern with the best signal-to-noise.
+demodulated at that frequency, carries the pattern with the best signal-to-noise; the
+direction is refined from the phase ramp across that band.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import cv2
 import numpy as np
@@ -27,6 +29,13 @@ class Strip:
     samples: np.ndarray  # rows (1 px apart) x columns (STEP_PX apart)
     valid: np.ndarray  # same shape, True inside the image
     along_start_px: float  # position of column 0 along the track from the image centre
+
+    @cached_property
+    def centred(self) -> np.ndarray:
+        """Samples minus their row mean, zero outside the image."""
+        n = np.maximum(self.valid.sum(axis=1), 1).astype(np.float32)
+        x = np.where(self.valid, self.samples, np.float32(0))
+        return x - (x.sum(axis=1) / n)[:, None] * self.valid
 
 
 def direction_candidates(gray: np.ndarray, min_period_px: float, max_period_px: float,
@@ -85,12 +94,9 @@ def resample(gray: np.ndarray, angle_rad: float) -> Strip:
 
 def _row_demodulation(strip: Strip, freq_per_sample: float) -> np.ndarray:
     """Complex amplitude of each row at the frequency (mean over its valid samples)."""
-    n = np.maximum(strip.valid.sum(axis=1), 1).astype(np.float32)
-    x = np.where(strip.valid, strip.samples, np.float32(0))
-    x -= (x.sum(axis=1) / n)[:, None] * strip.valid
-    arg = (2 * np.pi * freq_per_sample * np.arange(x.shape[1])) % (2 * np.pi)
-    both = x @ np.stack([np.cos(arg), -np.sin(arg)], axis=1).astype(np.float32)
-    return (both[:, 0] + 1j * both[:, 1]) / n
+    arg = (2 * np.pi * freq_per_sample * np.arange(strip.samples.shape[1])) % (2 * np.pi)
+    both = strip.centred @ np.stack([np.cos(arg), -np.sin(arg)], axis=1).astype(np.float32)
+    return (both[:, 0] + 1j * both[:, 1]) / np.maximum(strip.valid.sum(axis=1), 1)
 
 
 def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int, int, float]:
