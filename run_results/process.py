@@ -6,7 +6,9 @@ torque ``ty``, thrust ``H = T/r``, motion resistance ``R = T/r - DP`` (Wong, The
 Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correction; for
 steered runs also the side force ``fy`` and the slip angle (logged channel, else the
 set steering angle). Single-channel quantities come from the native samples, the means of
-resistance and sinkage from the channels' native means (``native``).
+resistance and sinkage from the channels' native means (``native``). Runs with track photos
+(``/camera/track``) also get ``image_slip``, the slip read from the grouser marks
+(``softflow.track_run``), beside the encoder slip.
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ from run_results.corrections import RigCompliance, corrected_heights, tare_recor
 from run_results.native import native_quantities
 from run_results.phase_average import phase_average
 from run_results.result import RunResult
-from run_results.stats import quantity_stats
+from run_results.stats import QuantityStats, quantity_stats
+from softflow.track_run import run_image_slip
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
 
@@ -118,10 +121,24 @@ def _flags(run, window, oscillation: dict) -> list[str]:
     return flags
 
 
+def _image_slip(run) -> tuple[dict[str, QuantityStats], list[str]]:
+    """``image_slip`` from the run's track photos (beside the encoder slip), and its flags."""
+    image = run_image_slip(run)
+    if image is None:
+        return {}, []
+    flags = [f"image slip: {reason}" for reason in image.refusals]
+    if image.slip is None:
+        return {}, flags
+    return {"image_slip": QuantityStats(mean=image.slip, std=image.slip_spread, se=image.slip_se,
+                                        n=image.used, n_eff=float(image.used), unit="1")}, flags
+
+
 def process_run(run, params: StablePhaseParams | None = None,
                 rig: RigCompliance | None = None) -> RunResult:
-    """Stable window, corrected quantities with honest SE, oscillation and flags of one run."""
+    """Stable window, corrected quantities with honest SE, oscillation and flags of one run
+    (and its image slip when it carries track photos)."""
     window = detect_stable_phase(run, params)
+    image_quantities, image_flags = _image_slip(run)
     series, applied = _series(run, rig)
     t = run.channels["t_s"].to_numpy()
     corrections = {"tare": tare_record(run),
@@ -133,8 +150,9 @@ def process_run(run, params: StablePhaseParams | None = None,
         trace = {"t_s": tb.tolist(), "dp_n": [None if not np.isfinite(v) else float(v)
                                               for v in dpb]}
         flags = (f"no stable phase: {window.reason}", *_flags(run, window, {
-            "grouser_expected_hz": None, "grouser_measured_hz": None}))
-        return RunResult(status="no_stable_phase", flags=flags, quantities={}, oscillation={},
+            "grouser_expected_hz": None, "grouser_measured_hz": None}), *image_flags)
+        return RunResult(status="no_stable_phase", flags=flags, quantities=image_quantities,
+                         oscillation={},
                          dp_trace=trace, corrections=corrections, **common)
     lo, hi = int(np.searchsorted(t, window.start_s)), int(np.searchsorted(t, window.end_s)) + 1
     oscillation, frequency = _oscillation(run, t, lo, hi, series)
@@ -152,6 +170,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     quantities.update({k: replace(quantities[k], mean=v) for k, v in combined.items()
                        if k in quantities})
     corrections["hub_height_correction_mean_m"] = float(np.nanmean(applied["correction_m"][lo:hi]))
-    flags = tuple(_flags(run, window, oscillation))
+    quantities.update(image_quantities)
+    flags = (*_flags(run, window, oscillation), *image_flags)
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,
                      oscillation=oscillation, dp_trace=None, corrections=corrections, **common)

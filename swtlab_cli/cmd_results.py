@@ -12,7 +12,7 @@ from swtlab_cli import exit_codes
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
                    "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
-                   "torque_nm_mean", "sinkage_m_mean", "resistance_n_mean"]
+                   "torque_nm_mean", "sinkage_m_mean", "resistance_n_mean", "image_slip_mean"]
 
 TOWED_COLUMNS = ["wheel", "soil", "multipass", "load_n", "towed_resistance_n",
                  "towed_resistance_se_n", "powered_resistance_at_zero_slip_n",

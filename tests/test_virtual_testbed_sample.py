@@ -5,9 +5,11 @@ and consistent with its truth files."""
 from __future__ import annotations
 
 import hashlib
+import base64
 import json
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 from mcap.reader import make_reader
@@ -49,6 +51,23 @@ def _read_mcap(path: Path):
         for record in reader.iter_metadata():
             metadata[record.name] = dict(record.metadata)
     return blocks, channels, metadata
+
+
+def _check_track_photos(channel, messages, metadata, truth):
+    """Spec: foxglove.CompressedImage JSON (timestamp, frame_id, format, base64 data), scale
+    in swt.camera_track."""
+    schema_encoding, schema, message_encoding = channel
+    assert (schema_encoding, message_encoding) == ("jsonschema", "json")
+    assert set(schema["required"]) == {"timestamp", "frame_id", "format", "data"}
+    assert len(messages) == truth["count"]
+    for message, t_ns in zip(messages, truth["t_ns"]):
+        stamp = message["timestamp"]
+        assert stamp["sec"] * 1_000_000_000 + stamp["nsec"] == t_ns
+        assert message["format"] == "jpeg"
+        image = cv2.imdecode(np.frombuffer(base64.b64decode(message["data"]), np.uint8),
+                             cv2.IMREAD_GRAYSCALE)
+        assert image is not None and image.shape == (600, 800)
+    assert float(metadata["swt.camera_track"]["px_per_m"]) == truth["px_per_m"]
 
 
 def _columns(blocks: list[dict]) -> dict[str, np.ndarray]:
@@ -101,7 +120,10 @@ def test_sample_contents_and_size():
     forms = {t["form"] for t in TRUTHS.values()}
     assert forms == {"mcap", "csv"}
     total_bytes = sum(f.stat().st_size for f in SAMPLE.rglob("*") if f.is_file())
-    assert total_bytes < 5_000_000
+    assert total_bytes < 6_000_000  # "a few MB at most"
+    photographed = [r for r, t in TRUTHS.items() if t.get("track_photos")]
+    assert sorted(photographed) == ["L180_MP0_SC_s+010", "L180_MP0_SC_s+035",
+                                    "L180_MP0_SC_s+060"]
 
 
 @pytest.mark.parametrize("run_id", ["L180_MP0_SC_s+020", "L300_MP0_SC_s+090", "L070_MP0_TW",
@@ -119,7 +141,11 @@ def test_regenerates_bit_for_bit(tmp_path, run_id):
 @pytest.mark.parametrize("run_id", [r for r, t in TRUTHS.items() if t["form"] == "mcap"])
 def test_mcap_runs_follow_the_spec(run_id):
     blocks, channels, metadata = _read_mcap(SAMPLE / TRUTHS[run_id]["raw_file"])
-    assert set(channels) == set(TOPICS)
+    photos = TRUTHS[run_id].get("track_photos")
+    assert set(channels) == set(TOPICS) | ({"/camera/track"} if photos else set())
+    if photos:
+        _check_track_photos(channels.pop("/camera/track"), blocks.pop("/camera/track"),
+                            metadata, photos)
     for topic, (schema_encoding, schema, message_encoding) in channels.items():
         assert (schema_encoding, message_encoding) == ("jsonschema", "json")
         assert set(schema["required"]) == {"t_ns", *TOPICS[topic]}

@@ -18,6 +18,7 @@ from virtual_testbed.measure import RawRun, measure
 from virtual_testbed.rig import BB2_WHEEL, Suspension, Timeline, Wheel
 from virtual_testbed.sensors import Rates, SensorModel
 from virtual_testbed.simulate import Dynamics, simulate_true_run
+from virtual_testbed.track_photos import TRACK_TOPIC, photo_seed, track_photos
 from virtual_testbed.truth import truth_record
 from virtual_testbed.write_csv import write_csv
 from virtual_testbed.write_mcap import write_mcap
@@ -31,6 +32,8 @@ class Testbed:
 
     law: PerformanceLaw = field(default_factory=bb2_sand_law)
     lateral: LateralLaw = LateralLaw()
+    #: ground scale of the track photos (px per m at the image centre)
+    track_px_per_m: float = 700.0
     wheel: Wheel = BB2_WHEEL
     suspension: Suspension = Suspension()
     timeline: Timeline = Timeline()
@@ -85,11 +88,23 @@ def make_run(condition: RunCondition, seed: int, start: str, testbed: Testbed,
                                  lateral=tb.lateral)
     measurement = measure(true_run, tb.wheel, tb.suspension, tb.rates, tb.sensors, rng,
                           run_metadata(condition, tb, start))
+    raw = measurement.raw
+    photos_truth = None
+    if condition.track_photos:
+        end_ns = int(round(tb.timeline.duration_s * 1e9))
+        photos = track_photos(true_run.steady["slip"], tb.wheel, condition.track_photos,
+                              tb.track_px_per_m, end_ns, photo_seed(rng))
+        raw = replace(raw, images={TRACK_TOPIC: photos},
+                      metadata={**raw.metadata, "camera_track": {"px_per_m": tb.track_px_per_m}})
+        photos_truth = {"count": len(photos), "px_per_m": tb.track_px_per_m,
+                        "slip": true_run.steady["slip"], "t_ns": [p.t_ns for p in photos]}
     truth = truth_record(true_run, radius_m=tb.wheel.radius_m, grouser_count=tb.wheel.grouser_count,
                          raw_file=raw_name(condition.run_id, form), form=form, seed=seed,
                          law_parameters=tb.law.parameters(), dynamics=tb.dynamics,
                          sensors=tb.sensors, rates=tb.rates, measurement_record=measurement.record)
-    return measurement.raw, truth
+    if photos_truth:
+        truth["track_photos"] = photos_truth
+    return raw, truth
 
 
 def raw_name(run_id: str, form: str) -> str:

@@ -26,6 +26,8 @@ class RunCondition:
     velocity_mps: float = VELOCITY_40_M_PER_H_MPS
     gravity_mps2: float = STANDARD_GRAVITY_MPS2
     steer_deg: float | None = None
+    #: photos of the track taken after the run (``/camera/track``), driving slip only
+    track_photos: int = 0
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -35,5 +37,7 @@ class RunCondition:
                              "there")
         if (self.mode == "steered") != (self.steer_deg is not None):
             raise ValueError("steer_deg is required for steered runs and only there")
+        if self.track_photos and not (self.mode in SLIP_IMPOSED and self.slip_setpoint >= 0):
+            raise ValueError("track photos are rendered for a driving slip set point >= 0")
         if self.slip_setpoint is not None and not -1.0 < self.slip_setpoint < 1.0:
             raise ValueError(f"slip_setpoint {self.slip_setpoint} outside (-1, 1)")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -24,6 +24,8 @@ class RawRun:
     metadata: dict[str, dict[str, float | int | str]]
     channels: dict[str, dict[str, np.ndarray]]
     blocks: dict[str, np.ndarray]
+    #: encoded camera frames per topic (``virtual_testbed.track_photos.TrackPhoto``)
+    images: dict[str, list] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

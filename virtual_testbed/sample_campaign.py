@@ -7,7 +7,8 @@ rewrites ``sample_data/`` bit for bit. Contents (see docs/virtual-testbed.md):
   90 % each (MCAP form);
 - a 120 N validation series, multipass 0, 5 slips between the others (MCAP form);
 - one towed and one free-sled run per load, multipass 0 (CSV form);
-- one steered run, 180 N, slip 0.2 at a 10 degree slip angle (MCAP form).
+- one steered run, 180 N, slip 0.2 at a 10 degree slip angle (MCAP form);
+- a photo of the track (``/camera/track``) after three 180 N runs (slip 10, 35, 60 %).
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ SEED = 20260
 LOADS_N = (70.0, 180.0, 300.0)
 MULTIPASSES = (0, 1)
 SLIPS = (-0.10, 0.0, 0.05, 0.10, 0.20, 0.35, 0.60, 0.90)
+#: runs whose track is photographed after the run (image slip beside encoder slip)
+PHOTOGRAPHED = {(180.0, 0, 0.10), (180.0, 0, 0.35), (180.0, 0, 0.60)}
 VALIDATION_LOAD_N = 120.0
 VALIDATION_SLIPS = (-0.05, 0.03, 0.15, 0.45, 0.75)
 #: Modest rates keep the committed sample small; the grouser frequency is below 2 Hz.
@@ -47,7 +50,8 @@ def sample_conditions() -> list[tuple[RunCondition, str]]:
     for load in LOADS_N:
         for mp in MULTIPASSES:
             runs += [(RunCondition(run_id(load, mp, "speed_control", s), "speed_control", load,
-                                   mp, s), "mcap") for s in SLIPS]
+                                   mp, s, track_photos=int((load, mp, s) in PHOTOGRAPHED)),
+                      "mcap") for s in SLIPS]
     runs += [(RunCondition(run_id(VALIDATION_LOAD_N, 0, "speed_control", s), "speed_control",
                            VALIDATION_LOAD_N, 0, s), "mcap") for s in VALIDATION_SLIPS]
     for load in LOADS_N:

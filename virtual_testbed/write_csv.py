@@ -19,4 +19,10 @@ def write_csv(raw: RawRun, folder: Path) -> Path:
         table = pd.DataFrame({"t_s": channel["t_ns"] / 1e9,
                               **{f: channel[f] for f in TOPIC_FIELDS[topic]}})
         table.to_csv(folder / csv_name(topic), index=False, lineterminator="\n")
+    for topic, photos in raw.images.items():
+        frames = folder / csv_name(topic).removesuffix(".csv")
+        frames.mkdir(exist_ok=True)
+        for photo in photos:
+            (frames / f"{photo.t_ns}.{'jpg' if photo.format == 'jpeg' else photo.format}"
+             ).write_bytes(photo.data)
     return folder

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import base64
 import json
 from datetime import datetime
 from pathlib import Path
@@ -41,6 +42,25 @@ def _blocks(raw: RawRun, topic: str):
         yield seq, int(channel["t_ns"][b - 1]), json.dumps(message, separators=(",", ":")).encode()
 
 
+#: JSON Schema of foxglove.CompressedImage as the spec uses it (timestamp since run start)
+IMAGE_SCHEMA = json.dumps({
+    "type": "object", "title": "foxglove.CompressedImage",
+    "properties": {"timestamp": {"type": "object", "properties": {
+        "sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
+        "frame_id": {"type": "string"}, "format": {"type": "string"},
+        "data": {"type": "string", "contentEncoding": "base64"}},
+    "required": ["timestamp", "frame_id", "format", "data"]}, separators=(",", ":")).encode()
+
+
+def _image_messages(topic: str, photos: list) -> list[tuple[int, bytes]]:
+    frame_id = topic.strip("/").replace("/", "_")
+    return [(p.t_ns, json.dumps({
+        "timestamp": {"sec": p.t_ns // 1_000_000_000, "nsec": p.t_ns % 1_000_000_000},
+        "frame_id": frame_id, "format": p.format,
+        "data": base64.b64encode(p.data).decode()}, separators=(",", ":")).encode())
+        for p in photos]
+
+
 def write_mcap(raw: RawRun, path: Path) -> Path:
     """Write ``raw`` to ``path`` (``.mcap``); same input, same bytes."""
     started = datetime.fromisoformat(raw.metadata["run"]["started_at"].replace("Z", "+00:00"))
@@ -55,6 +75,13 @@ def write_mcap(raw: RawRun, path: Path) -> Path:
             channel_id = writer.register_channel(topic=topic, message_encoding="json",
                                                  schema_id=schema_id)
             messages += [(t_ns, channel_id, seq, data) for seq, t_ns, data in _blocks(raw, topic)]
+        for topic, photos in raw.images.items():
+            schema_id = writer.register_schema(name="foxglove.CompressedImage",
+                                               encoding="jsonschema", data=IMAGE_SCHEMA)
+            channel_id = writer.register_channel(topic=topic, message_encoding="json",
+                                                 schema_id=schema_id)
+            messages += [(t_ns, channel_id, seq, data)
+                         for seq, (t_ns, data) in enumerate(_image_messages(topic, photos))]
         for t_ns, channel_id, seq, data in sorted(messages, key=lambda m: m[:3]):
             writer.add_message(channel_id=channel_id, log_time=epoch_ns + t_ns, data=data,
                                publish_time=epoch_ns + t_ns, sequence=seq)
