@@ -24,7 +24,7 @@ def truth_results_table() -> pd.DataFrame:
     for path in sorted(TRUTH.glob("*.json")):
         truth = json.loads(path.read_text())
         means, condition = truth["stable_means"], truth["condition"]
-        if means is None:  # dig-in, no stable phase
+        if means is None or condition["mode"] == "steered":  # dig-in; not a curve point
             continue
         se = run_se(condition["load_n"])
         rows.append({"wheel": "bb2", "soil": "es3", "multipass": condition["multipass"],
@@ -37,7 +37,7 @@ def truth_results_table() -> pd.DataFrame:
 
 def test_sample_campaign_120n_validation_from_true_stable_means():
     table = truth_results_table()
-    assert len(table) == 56  # 59 runs, 3 dig-in
+    assert len(table) == 56  # 60 runs, 3 dig-in, 1 steered
     results = {r.quantity: r for r in validate_load_interpolation(table, 120.0)}
     dp = results["dp_n"]
     assert (dp.multipass, dp.n_points, dp.n_outside_slip_range) == (0, 5, 1)
