@@ -26,7 +26,9 @@ demo: $(STAMP)
 	$(BIN)/swtlab results --db sqlite:///$(OUT)/swtlab.sqlite --csv $(OUT)/results.csv
 	$(BIN)/swtlab export --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/wpm.csv
 	$(BIN)/swtlab wpm query $(OUT)/wpm.csv --load 120 --dp 25 --multipass 0
-	@echo "results: database $(OUT)/swtlab.sqlite, one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv"
+	$(BIN)/swtlab report --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/report.html
+	@echo "results: report $(OUT)/report.html (open it in a browser), database $(OUT)/swtlab.sqlite,"
+	@echo "         one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

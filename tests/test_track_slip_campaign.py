@@ -35,3 +35,10 @@ def test_image_slip_beside_encoder_slip(tmp_path, capsys):
         assert row["image_slip_mean"] == pytest.approx(truth["track_photos"]["slip"], abs=0.005)
         assert abs(row["image_slip_mean"] - row["slip_mean"]) < 0.01  # below 1 % of slip
         assert 0 < row["image_slip_se"] < 0.005
+    # the report shows the two side by side with their difference
+    page = tmp_path / "report.html"
+    assert main(["report", "--db", db, "-o", str(page), "--quiet"]) == 0
+    html = page.read_text()
+    assert "Image slip against encoder slip" in html
+    assert all(f">P{i}<" in html for i in range(len(slips)))
+    assert "within the 1 %" in html and "NOT within" not in html

@@ -1,0 +1,199 @@
+"""The page's figures, one function each, drawn with matplotlib on plain ``Figure`` objects
+(no pyplot state). Every axis is labelled with its unit; loads and multipasses look the same
+in every figure (:class:`campaign_report.style.Palette`)."""
+
+from __future__ import annotations
+
+import textwrap
+import warnings
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from campaign_report.data import RunRecord, SetKey
+from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
+from fitting import CurveFit, ValidationResult, curves_by_load, interpolate_load
+from wpm_export import WheelPerformanceModule
+
+#: channels of the per-run time series: (channel column, quantity shown)
+TIMESERIES = (("dp_n", "dp_n"), ("ty_nm", "torque_nm"), ("sinkage_m", "sinkage_m"),
+              ("slip", "slip"))
+WINDOW_COLOUR = "#cfe3cf"
+CURVE_POINTS = 200
+
+
+def _robust_limits(ax, values: np.ndarray) -> None:
+    """Y limits from the 0.5-99.5 % range, so one spike at a run's start does not flatten it."""
+    finite = values[np.isfinite(values)]
+    if finite.size < 2:
+        return
+    lo, hi = np.percentile(finite, [0.5, 99.5])
+    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.1
+    ax.set_ylim(lo - pad, hi + pad)
+
+
+def _no_data(ax, text: str) -> None:
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4")
+
+
+def run_timeseries(run: RunRecord, channels: pd.DataFrame | None, palette: Palette) -> Figure:
+    """Drawbar pull, torque, sinkage and slip against time, the stable window shaded with
+    each quantity's mean over it; a run with no stable phase gets its stored DP trace and the
+    reason. ``channels``: ``ingest.read_run(...).channels`` or None if the raw file is gone."""
+    fig = Figure(figsize=(8.0, 6.4))  # fixed margins: constrained layout would double the cost
+    axes = fig.subplots(len(TIMESERIES), 1, sharex=True)
+    top = 0.93 if run.status != "no_stable_phase" else 0.86
+    fig.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
+    colour = palette.colour(run.load_n)
+    for ax, (column, key) in zip(axes, TIMESERIES):
+        q = QUANTITIES[key]
+        ax.set_ylabel(q.axis_label)
+        ax.grid(alpha=0.3)
+        if run.window_start_s is not None and run.window_end_s is not None:
+            ax.axvspan(run.window_start_s, run.window_end_s, color=WINDOW_COLOUR, zorder=0,
+                       label="stable window")
+            if key in run.means:
+                ax.hlines(run.means[key] * q.scale, run.window_start_s, run.window_end_s,
+                          colors="k", linestyles="--", lw=1.2, label="mean over window")
+        values = None if channels is None else channels[column].to_numpy(float) * q.scale
+        if values is not None and np.isfinite(values).any():
+            ax.plot(channels["t_s"], values, color=colour, lw=0.8, label="raw file")
+            _robust_limits(ax, values)
+        elif not (key == "dp_n" and run.dp_trace):
+            _no_data(ax, "not measured" if channels is not None else "raw file not readable")
+        if key == "dp_n" and run.dp_trace:
+            trace = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
+            ax.plot(run.dp_trace["t_s"], trace, color="k", lw=1.0, label="stored DP trace")
+    axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
+    labelled = {}
+    for ax in axes:
+        labelled.update(zip(*reversed(ax.get_legend_handles_labels())))
+    fig.legend(labelled.values(), labelled.keys(), loc="lower center", ncols=len(labelled),
+               frameon=False, fontsize="small")
+    title = (f"{run.run_id}: {run.mode}, {run.load_n:g} N, multipass {run.multipass}"
+             + (f", slip set {100 * run.slip_setpoint:g} %" if run.slip_setpoint is not None
+                else ""))
+    if run.status == "no_stable_phase":
+        reason = "; ".join(run.flags)
+        title += "\n" + "\n".join(textwrap.wrap(reason, 110))
+    fig.suptitle(title, fontsize="medium",
+                 color="#a00000" if run.status != "ok" else "k")
+    return fig
+
+
+def _errorbars(ax, rows: pd.DataFrame, key: str, colour: str, marker: str,
+               fitted: bool) -> None:
+    q = QUANTITIES[key]
+    se = rows[f"{key}_se"] if f"{key}_se" in rows else None
+    ax.errorbar(rows["slip"] * 100.0, rows[key] * q.scale,
+                yerr=None if se is None else se * q.scale, fmt=marker, ms=5, color=colour,
+                mfc=colour if fitted else "white", capsize=2.5, lw=1, zorder=3)
+
+
+def _curve(ax, curve, quantity: str, colour: str, ls: str = "-", lw: float = 1.6,
+           alpha: float = 1.0) -> None:
+    """A polynomial over its own slip range, slip in %, the value in the display unit."""
+    slip = np.linspace(curve.slip_min, curve.slip_max, CURVE_POINTS)
+    ax.plot(slip * 100.0, curve.evaluate(slip) * QUANTITIES[quantity].scale, color=colour,
+            ls=ls, lw=lw, alpha=alpha)
+
+
+def _slip_axes(fig: Figure, keys) -> list:
+    axes = fig.subplots(2, (len(keys) + 1) // 2, squeeze=False).ravel()
+    for ax, key in zip(axes, keys):
+        ax.set_xlabel(QUANTITIES["slip"].axis_label)
+        ax.set_ylabel(QUANTITIES[key].axis_label)
+        ax.set_title(QUANTITIES[key].label.capitalize(), fontsize="medium")
+        ax.grid(alpha=0.3)
+    return list(axes)
+
+
+def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, soil: str,
+                       statuses, palette: Palette) -> Figure:
+    """DP, torque, sinkage and resistance against slip for one wheel on one soil: every
+    load and multipass, means with their standard errors as error bars (hollow: runs whose
+    status is not in ``statuses``, i.e. not fitted) and the fitted polynomials."""
+    fig = Figure(figsize=(11.0, 8.2), layout="constrained")
+    axes = _slip_axes(fig, CURVE_QUANTITIES)
+    mine = points[(points["wheel"] == wheel) & (points["soil"] == soil)]
+    for ax, key in zip(axes, CURVE_QUANTITIES):
+        for (mp, load), rows in mine.groupby(["multipass", "load_n"]):
+            rows = rows[np.isfinite(rows[key].astype(float))]
+            for fitted, part in rows.groupby(rows["status"].isin(list(statuses))):
+                _errorbars(ax, part, key, palette.colour(load), palette.marker(mp), fitted)
+        for f in fits:
+            if (f.wheel, f.soil, f.quantity) == (wheel, soil, key):
+                _curve(ax, f, key, palette.colour(f.load_n), palette.line(f.multipass))
+    handles = palette.legend_handles(mine["load_n"], mine["multipass"])
+    if not mine["status"].isin(list(statuses)).all():
+        handles.append(Line2D([], [], ls="", marker="o", color="0.3", mfc="white",
+                              label="flagged, not fitted"))
+    fig.legend(handles=handles, loc="outside right upper", title="load, soil pass")
+    fig.suptitle(f"{wheel} on {soil}: means ± standard error, fitted polynomials",
+                 fontsize="medium")
+    return fig
+
+
+def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, load_n: float,
+                    checks: list[ValidationResult], palette: Palette) -> Figure:
+    """The curves at the tested loads interpolated to ``load_n`` (thick) against the runs at
+    ``load_n`` kept aside (points ± standard error), one panel per quantity, the RMSE as %
+    of the measured range in each title."""
+    fig = Figure(figsize=(11.0, 8.2), layout="constrained")
+    axes = _slip_axes(fig, CURVE_QUANTITIES)
+    by_quantity = {c.quantity: c for c in checks}
+    sets = curves_by_load(f for f in fits if (f.wheel, f.soil, f.multipass) == key)
+    rows = points[(points["wheel"] == key[0]) & (points["soil"] == key[1])
+                  & (points["multipass"] == key[2]) & np.isclose(points["load_n"], load_n)]
+    colour, mp = palette.colour(load_n), key[2]
+    for ax, q in zip(axes, CURVE_QUANTITIES):
+        tested = sets.get((*key, q), {})
+        for load, curve in sorted(tested.items()):
+            _curve(ax, curve, q, palette.colour(load), palette.line(mp), lw=1.0)
+        if len(tested) >= 2:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                interpolated = interpolate_load(tested, load_n)
+            _curve(ax, interpolated, q, colour, palette.line(mp), lw=3.0, alpha=0.85)
+        ok = rows[np.isfinite(rows[q].astype(float))]
+        _errorbars(ax, ok, q, colour, palette.marker(mp), fitted=True)
+        check = by_quantity.get(q)
+        if check is not None:
+            unit = QUANTITIES[q]
+            ax.set_title(f"{unit.label.capitalize()}: RMSE {check.rmse * unit.scale:.3g} "
+                         f"{unit.unit} = {check.rmse_pct_of_range:.2g} % of range",
+                         fontsize="medium")
+    fig.legend(handles=palette.legend_handles([*sets.get((*key, "dp_n"), {}), load_n], [mp]),
+               loc="outside right upper", title="load")
+    fig.suptitle(f"{key[0]} on {key[1]}, multipass {mp}: curves interpolated to "
+                 f"{load_n:g} N against the {load_n:g} N runs (not used in the fits)",
+                 fontsize="medium")
+    return fig
+
+
+def wpm_curves(wpm: WheelPerformanceModule, tested: dict[str, list[float]], soil: str,
+               wheel: str, multipass: int, palette: Palette) -> Figure:
+    """Every quantity of one WPM curve set as exported, evaluated by the WPM runtime: the
+    curves at the tested loads (``tested``: quantity -> loads) and, thin grey, at loads
+    between them."""
+    selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
+    quantities = [q for q in wpm.quantities(**selection) if q in tested]
+    fig = Figure(figsize=(12.0, 7.6), layout="constrained")
+    axes = _slip_axes(fig, quantities)
+    for ax, q in zip(axes, quantities):
+        loads = sorted(tested[q])
+        for load in (np.array(loads[1:]) + np.array(loads[:-1])) / 2.0:
+            _curve(ax, wpm.curve(q, float(load), **selection), q, "0.6", ":", lw=1.0)
+        for load in loads:
+            _curve(ax, wpm.curve(q, load, **selection), q, palette.colour(load),
+                   palette.line(multipass), lw=1.8)
+    for ax in axes[len(quantities):]:
+        ax.set_axis_off()
+    handles = palette.legend_handles([x for q in quantities for x in tested[q]], [multipass])
+    handles.append(Line2D([], [], color="0.6", ls=":", label="between (WPM runtime)"))
+    fig.legend(handles=handles, loc="outside right upper", title="load")
+    fig.suptitle(f"WPM curves as exported: {wheel} on {soil}, multipass {multipass}",
+                 fontsize="medium")
+    return fig

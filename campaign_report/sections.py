@@ -1,0 +1,149 @@
+"""The page's built-in sections, from a campaign's gathered data and its rendered figures."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from html import escape
+
+from campaign_report import figures
+from campaign_report.data import CampaignData, RunRecord, read_channels
+from campaign_report.html import Heading, Image, Note, Section, Table
+from campaign_report.images import thumbnail, to_png
+from campaign_report.style import QUANTITIES, Palette
+from wpm_export import WheelPerformanceModule
+
+RUNS = "runs"
+TIMESERIES = "timeseries"
+CURVES = "curves"
+INTERPOLATION = "interpolation"
+WPM = "wpm"
+
+
+def run_anchor(index: int) -> str:
+    """Anchor of a run's time-series thumbnail (run ids may hold characters a slug would merge)."""
+    return f"run-{index}"
+
+
+def _number(value: float | None, scale: float = 1.0, digits: int = 4) -> str:
+    return "" if value is None else f"{value * scale:.{digits}g}"
+
+
+def _window(run: RunRecord) -> str:
+    if run.window_start_s is None or run.window_end_s is None:
+        return "none"
+    return f"{run.window_start_s:.1f}-{run.window_end_s:.1f}"
+
+
+def runs_section(data: CampaignData) -> Section:
+    """Every run: conditions, status, stable window, main means, flags and reasons."""
+    header = ["run", "mode", "load [N]", "multipass", "slip set [%]", "velocity [mm/s]",
+              "status", "stable window [s]", "slip [%]", "DP [N]", "torque [N·m]",
+              "sinkage [mm]", "flags and reasons"]
+    rows, classes = [], []
+    for i, run in enumerate(data.runs):
+        m = run.means
+        rows.append([
+            f'<a href="#full-{run_anchor(i)}">{escape(run.run_id)}</a>', run.mode,
+            f"{run.load_n:g}", str(run.multipass), _number(run.slip_setpoint, 100.0, 3),
+            _number(run.velocity_mps, 1000.0, 3),
+            f'<span class="status {escape(run.status)}">{escape(run.status)}</span>', _window(run),
+            _number(m.get("slip"), 100.0, 3), _number(m.get("dp_n")),
+            _number(m.get("torque_nm")), _number(m.get("sinkage_m"), 1000.0, 3),
+            "; ".join(run.flags)])
+        classes.append(run.status)
+    counts = {s: sum(r.status == s for r in data.runs) for s in ("ok", "flagged",
+                                                                   "no_stable_phase")}
+    summary = (f"{len(data.runs)} runs: {counts['ok']} ok, {counts['flagged']} flagged (a check "
+               f"failed; kept out of the fits), {counts['no_stable_phase']} without a stable "
+               "phase. Means over the stable window; a run id opens its time series.")
+    return Section(RUNS, "Runs", [Note(summary), Table(
+        header, rows, numeric=frozenset({2, 3, 4, 5, 8, 9, 10, 11}), row_classes=classes,
+        html_columns=frozenset({0, 6}))])
+
+
+def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Image:
+    """A run's time-series thumbnail/full-size pair; the caption says why when its raw file
+    could not be read."""
+    channels, problem = read_channels(run)
+    png, image = to_png(figures.run_timeseries(run, channels, palette))
+    caption = f"{run.run_id} · {run.status}" + (f" · {problem}" if problem else "")
+    return Image(run_anchor(index), caption, png, thumbnail(image), run.status)
+
+
+def timeseries_section(images: Iterable[Image]) -> Section:
+    return Section(TIMESERIES, "Time series per run", [Note(
+        "Drawbar pull, torque, sinkage and slip from each run's raw file; the stable window "
+        "shaded, the dashed line its mean. Runs with no stable phase show the DP trace "
+        "stored by processing and the reason. Click a thumbnail for full size."), *images])
+
+
+def _source_notes(data: CampaignData) -> list[Note]:
+    src = data.source
+    statuses = ", ".join(src.statuses)
+    if src.exported:
+        when = src.created_at.strftime("%Y-%m-%d %H:%M UTC") if src.created_at else "?"
+        notes = [Note(f"Curves of the newest WPM export {src.export_path} (sha256 "
+                      f"{src.file_sha256[:12]}, {when}), degree {src.degree}, fitted from runs "
+                      f"with status {statuses}.")]
+        if src.stale:
+            notes.append(Note("The export was fitted from older results than the newest "
+                              "ones: run swtlab export again to bring it up to date.",
+                              warning=True))
+    else:
+        notes = [Note(f"No WPM export of this campaign in the database: curves fitted here "
+                      f"(degree {src.degree}, runs with status {statuses}); swtlab export "
+                      "writes and records them.")]
+    for (wheel, soil, mp), load, slips in data.unfitted_groups():
+        notes.append(Note(f"{wheel} on {soil}, multipass {mp}, {load:g} N: {slips} distinct "
+                          "slips, no curve (too few to fit); shown as points."))
+    return notes
+
+
+def curves_section(data: CampaignData, palette: Palette) -> Section:
+    """DP, torque, sinkage and resistance against slip per wheel and soil."""
+    blocks: list = _source_notes(data)
+    for wheel, soil in sorted({(w, s) for w, s, _ in data.sets()}):
+        fig = figures.performance_curves(data.points, data.fits, wheel, soil,
+                                         data.source.statuses, palette)
+        blocks.append(Image(f"curves-{len(blocks)}", f"{wheel} on {soil}: performance curves",
+                            to_png(fig)[0]))
+    return Section(CURVES, "Performance curves", blocks)
+
+
+def interpolation_section(data: CampaignData, palette: Palette) -> Section | None:
+    """Curves interpolated to a load kept aside, against that load's runs; None without one."""
+    if not data.validation:
+        return None
+    blocks: list = [Note("Runs at a load with too few slips for a curve of its own, between "
+                         "tested loads, check the load interpolation (RUAG WPAT's 120 N "
+                         "check): the curves at the other loads are interpolated to it.")]
+    for key, (load, checks) in data.validation.items():
+        blocks.append(Heading(f"{key[0]} on {key[1]}, multipass {key[2]}: {load:g} N"))
+        fig = figures.load_validation(data.points, data.fits, key, load, checks, palette)
+        blocks.append(Image(f"interp-{len(blocks)}", f"interpolated to {load:g} N",
+                            to_png(fig)[0]))
+        rows = [[(q := QUANTITIES[c.quantity]).label, f"{c.rmse * q.scale:.3g} {q.unit}",
+                 f"{c.rmse_pct_of_range:.2g}", str(c.n_points), str(c.n_outside_slip_range)]
+                for c in checks]
+        blocks.append(Table(["quantity", "RMSE", "% of measured range", "runs",
+                             "beyond the tested slips (not in RMSE)"], rows,
+                            numeric=frozenset({1, 2, 3, 4})))
+    return Section(INTERPOLATION, "Load interpolation check", blocks)
+
+
+def wpm_section(data: CampaignData, palette: Palette) -> Section | None:
+    """The exported WPM curves as the WPM runtime evaluates them; None without an export."""
+    if not data.source.exported:
+        return None
+    wpm = WheelPerformanceModule(data.fits, source=data.source.export_path)
+    blocks: list = [Note(f"{data.source.export_path}: every curve set as a simulator reads it "
+                         "(swtlab wpm query), at the tested loads and half-way between.")]
+    for wheel, soil, mp in data.sets():
+        tested: dict[str, list[float]] = {}
+        for f in data.fits:
+            if (f.wheel, f.soil, f.multipass) == (wheel, soil, mp):
+                tested.setdefault(f.quantity, []).append(f.load_n)
+        fig = figures.wpm_curves(wpm, tested, soil, wheel, mp, palette)
+        blocks.append(Image(f"wpm-{len(blocks)}", f"WPM curves, {wheel} on {soil}, "
+                            f"multipass {mp}", to_png(fig)[0]))
+    return Section(WPM, "WPM curves as exported", blocks)

@@ -1,0 +1,76 @@
+"""``swtlab report --db URL -o report.html``: one self-contained HTML page per campaign.
+
+The run table, each run's time series with its stable window, the performance curves with
+their points and error bars, the load-interpolation check and the exported WPM curves, every
+figure embedded (docs/report.md). One campaign: the page is written to -o; several: one page
+each, <stem>-<campaign>.html beside it, or only --campaign NAME's page to -o.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from swtlab_cli import exit_codes
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    lines = __doc__.splitlines()
+    parser = sub.add_parser(
+        "report", help="write the campaign report: one self-contained HTML page per campaign",
+        description=" ".join(line.strip() for line in lines[2:]))
+    parser.add_argument("--db", required=True, help="SQLAlchemy URL of a processed campaign")
+    parser.add_argument("-o", "--output", type=Path, required=True,
+                        help="HTML page to write (several campaigns: <stem>-<campaign>.html)")
+    parser.add_argument("--campaign", help="write only this campaign's page, to --output")
+    parser.add_argument("--json", action="store_true",
+                        help="print the pages written as JSON ({campaign, path, bytes})")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.set_defaults(func=run)
+
+
+def _missing_sqlite_file(url: str) -> Path | None:
+    """The file of a sqlite URL when it does not exist (opening would create an empty one)."""
+    if url.startswith("sqlite:///") and url != "sqlite:///:memory:":
+        path = Path(url.removeprefix("sqlite:///"))
+        return None if path.is_file() else path
+    return None
+
+
+def run(args: argparse.Namespace) -> int:
+    from sqlalchemy.exc import SQLAlchemyError
+
+    from campaign_report import write_report, write_reports
+
+    missing = _missing_sqlite_file(args.db)
+    if missing:
+        print(f"swtlab report: {missing}: no such database file (run swtlab process CAMPAIGN "
+              f"--db {args.db} first)", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    try:
+        if args.campaign:
+            pages = {args.campaign: write_report(args.db, args.output, args.quiet,
+                                                 args.campaign)}
+        else:
+            pages = write_reports(args.db, args.output, args.quiet)
+    except LookupError as error:
+        print(f"swtlab report: {error.args[0]}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    except SQLAlchemyError as error:
+        print(f"swtlab report: {args.db}: cannot read the database "
+              f"({type(error).__name__}); check the URL", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    except OSError as error:
+        print(f"swtlab report: cannot write {error.filename or args.output}: "
+              f"{error.strerror or error}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    if args.json:
+        print(json.dumps([{"campaign": name, "path": str(path),
+                           "bytes": path.stat().st_size} for name, path in pages.items()],
+                         indent=1))
+    else:
+        for name, path in pages.items():
+            print(f"campaign {name}: {path} ({path.stat().st_size / 1e6:.1f} MB)")
+    return exit_codes.OK

@@ -1,0 +1,280 @@
+"""swtlab report: the page's content and self-containment, the figures' labels and colours,
+curves with and without a WPM export, optional sections, the command line."""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import json
+import re
+import shutil
+from dataclasses import replace
+from html import unescape
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from sqlalchemy import select, update
+
+from campaign_report import figures, page_paths, sections, write_report
+from campaign_report.data import campaign_names, gather
+from campaign_report.extensions import Extension, optional_sections, register, unregister
+from campaign_report.html import Image, Note, Section
+from campaign_report.style import Palette
+from swtlab_cli import cmd_report, exit_codes
+from test_report_campaign import FLAG, FLAGGED_RUN, NO_STABLE_RUN, build_small_campaign
+from traceability import open_database
+from traceability.models import Campaign, Run, TestCondition, WpmExport
+from traceability.queries import latest_results
+from wpm_export import WheelPerformanceModule
+
+UNIT = re.compile(r"\[[^\]]+\]$")
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    """(database URL, report path, page text) of the small campaign, exported and reported."""
+    folder = tmp_path_factory.mktemp("report")
+    url = build_small_campaign(folder)
+    page = write_report(url, folder / "report.html", quiet=True)
+    return url, page, page.read_text(encoding="utf-8")
+
+
+@pytest.fixture
+def fast_timeseries(monkeypatch):
+    """Per-run figures replaced by a tiny image, for tests about the page around them."""
+    png = cv2.imencode(".png", np.full((4, 6, 3), 200, np.uint8))[1].tobytes()
+    monkeypatch.setattr(sections, "timeseries_image",
+                        lambda i, run, palette: Image(sections.run_anchor(i), run.run_id, png,
+                                                      png, run.status))
+
+
+def _copy_db(url: str, folder: Path) -> str:
+    target = folder / "copy.sqlite"
+    shutil.copy2(url.removeprefix("sqlite:///"), target)
+    return f"sqlite:///{target}"
+
+
+def _cli(argv: list[str]) -> int:
+    """``swtlab report ...`` through its own parser (the command as main() registers it)."""
+    parser = argparse.ArgumentParser(prog="swtlab")
+    cmd_report.register(parser.add_subparsers())
+    args = parser.parse_args(["report", *argv])
+    return args.func(args)
+
+
+def test_page_is_self_contained_and_every_image_decodes(small):
+    _, _, text = small
+    assert "<script" not in text and "<link" not in text and "@import" not in text
+    references = re.findall(r'(?:src|href)="([^"]*)"', text)
+    assert references and not [r for r in references if re.match(r"[a-z]+:(?!image/png)", r)
+                                and not r.startswith("data:image/png;base64,")]
+    assert "http://" not in text and "https://" not in text
+    sources = re.findall(r'<img src="([^"]+)"', text)
+    widths = []
+    for src in sources:
+        assert src.startswith("data:image/png;base64,")
+        image = cv2.imdecode(np.frombuffer(base64.b64decode(src.split(",", 1)[1]), np.uint8),
+                             cv2.IMREAD_COLOR)
+        assert image is not None and image.shape[0] > 0 and image.std() > 5
+        widths.append(image.shape[1])
+    assert widths.count(300) >= 20  # one thumbnail per run
+    ids = set(re.findall(r'id="([^"]+)"', text))
+    fragments = {h[1:] for h in references if h.startswith("#")}
+    assert fragments <= ids  # every thumbnail and run link opens something on the page
+
+
+def test_page_lists_every_run_with_its_status_and_reasons(small):
+    url, page, text = small
+    with open_database(url)() as session:
+        results = latest_results(session)
+    rows = {re.search(r">([^<]+)</a>", row).group(1): row
+            for row in re.findall(r"<tr class=\"(?:ok|flagged|no_stable_phase)\">(.*?)</tr>", text)}
+    assert set(results["run_id"]) <= set(rows) and len(results) == 20
+    assert 'class="status flagged"' in rows[FLAGGED_RUN] and FLAG in unescape(rows[FLAGGED_RUN])
+    reason = results.set_index("run_id").loc[NO_STABLE_RUN, "no_window_reason"]
+    assert "no_stable_phase" in rows[NO_STABLE_RUN] and reason in unescape(rows[NO_STABLE_RUN])
+    for title in ("Runs", "Time series per run", "Performance curves",
+                  "Load interpolation check", "WPM curves as exported"):
+        assert f"<h2>{title}</h2>" in text
+    assert len(re.findall(r'<div class="lightbox" id="full-run-\d+"', text)) == 20
+    assert "120 N: 4 distinct slips, no curve" in unescape(text)
+    assert page.stat().st_size < 3_000_000
+
+
+def test_figures_label_every_axis_with_a_unit_and_share_load_colours(small):
+    url, _, _ = small
+    with open_database(url)() as session:
+        data = gather(session, "bb2_sand_sample")
+    palette = Palette(data.loads, data.multipasses)
+    run = next(r for r in data.runs if r.run_id == "L180_MP0_SC_s+020")
+    nsp = next(r for r in data.runs if r.run_id == NO_STABLE_RUN)
+    key = ("BB2-like", "ES-3-like sand", 0)
+    tested = {}
+    for f in data.fits:
+        tested.setdefault(f.quantity, []).append(f.load_n)
+    figs = {
+        "timeseries": figures.run_timeseries(run, None, palette),
+        "no_stable": figures.run_timeseries(nsp, None, palette),
+        "curves": figures.performance_curves(data.points, data.fits, *key[:2],
+                                             data.source.statuses, palette),
+        "interpolation": figures.load_validation(data.points, data.fits, key, 120.0,
+                                                 data.validation[key][1], palette),
+        "wpm": figures.wpm_curves(WheelPerformanceModule(data.fits), tested, key[1], key[0],
+                                  0, palette),
+    }
+    for name, fig in figs.items():
+        for ax in (a for a in fig.axes if a.axison):
+            assert UNIT.search(ax.get_ylabel()), (name, ax.get_ylabel())
+            if ax.get_xlabel() or ax is fig.axes[-1]:
+                assert UNIT.search(ax.get_xlabel()), (name, ax.get_xlabel())
+    # the stored DP trace and the reason stand in for a no-stable-phase run's raw file
+    assert "stored DP trace" in figs["no_stable"].axes[0].get_legend_handles_labels()[1]
+    assert "digs in" in figs["no_stable"].get_suptitle()
+    legend = [t.get_text() for t in figs["curves"].legends[0].get_texts()]
+    assert legend == ["70 N", "120 N", "180 N", "flagged, not fitted"]
+    colour_180 = palette.colour(180.0)
+    curve_colours = {line.get_color() for line in figs["curves"].axes[0].lines
+                     if len(line.get_xdata()) == figures.CURVE_POINTS}
+    assert colour_180 in curve_colours and len(curve_colours) == 2  # 70 and 180 N
+    assert palette.colour(70.0) != colour_180 != palette.colour(120.0)
+    # the interpolated 120 N curve wears 120 N's colour, its runs' points too
+    thick = [line for line in figs["interpolation"].axes[0].lines if line.get_linewidth() >= 3]
+    assert [line.get_color() for line in thick] == [palette.colour(120.0)]
+
+
+def test_embedded_curves_keep_every_load_colour(small):
+    """The palette PNG must not merge two loads' colours (e.g. orange into vermilion)."""
+    _, _, text = small
+    src = re.search(r'<figure class="full" id="curves-\d+"><img src="data:image/png;base64,'
+                    r'([^"]+)"', text).group(1)
+    image = cv2.imdecode(np.frombuffer(base64.b64decode(src), np.uint8), cv2.IMREAD_COLOR)
+    present = {"#%02x%02x%02x" % tuple(int(v) for v in bgr[::-1])
+               for bgr in np.unique(image.reshape(-1, 3), axis=0)}
+    palette = Palette([70.0, 120.0, 180.0], [0])
+    assert {palette.colour(x).lower() for x in (70.0, 120.0, 180.0)} <= present
+
+
+def test_time_series_shades_the_stable_window(small):
+    url, _, _ = small
+    with open_database(url)() as session:
+        data = gather(session, "bb2_sand_sample")
+    run = next(r for r in data.runs if r.run_id == "L070_MP0_SC_s+020")
+    fig = figures.run_timeseries(run, None, Palette(data.loads, data.multipasses))
+    spans = [p for p in fig.axes[0].patches]
+    assert len(spans) == 1
+    x0, x1 = spans[0].get_x(), spans[0].get_x() + spans[0].get_width()
+    assert (x0, x1) == pytest.approx((run.window_start_s, run.window_end_s))
+
+
+def test_a_raw_file_gone_since_processing_is_said_so(small, tmp_path):
+    url, _, _ = small
+    with open_database(url)() as session:
+        data = gather(session, "bb2_sand_sample")
+    palette = Palette(data.loads, data.multipasses)
+    nsp = next(r for r in data.runs if r.run_id == NO_STABLE_RUN)
+    moved = replace(nsp, raw_path=str(tmp_path / "moved.mcap"))
+    image = sections.timeseries_image(0, moved, palette)
+    assert "moved.mcap not readable" in image.caption
+    fig = figures.run_timeseries(moved, None, palette)
+    assert fig.axes[0].get_legend_handles_labels()[1] == ["stored DP trace"]
+    assert [t.get_text() for t in fig.axes[1].texts] == ["raw file not readable"]
+
+
+def test_without_an_export_the_curves_are_fitted_here_from_ok_runs(small, tmp_path):
+    url = _copy_db(small[0], tmp_path)
+    with open_database(url).begin() as session:
+        for export in session.scalars(select(WpmExport)):
+            session.delete(export)
+    with open_database(url)() as session:
+        data = gather(session, "bb2_sand_sample")
+    assert not data.source.exported and data.source.statuses == ("ok",)
+    dp70 = next(f for f in data.fits if f.quantity == "dp_n" and f.load_n == 70.0)
+    at_70 = data.points[data.points["load_n"] == 70.0]
+    assert len(at_70) == 8 and dp70.n_points == 7  # the flagged run left out
+    assert sections.wpm_section(data, Palette(data.loads, data.multipasses)) is None
+    notes = [b.text for b in sections.curves_section(
+        data, Palette(data.loads, data.multipasses)).blocks if isinstance(b, Note)]
+    assert any("No WPM export" in n for n in notes)
+
+
+def test_optional_sections_appear_only_with_data(small, tmp_path, fast_timeseries):
+    url = small[0]
+    calls = []
+
+    def with_data(session, data, palette):
+        calls.append(data.name)
+        return Section("image-slip", "Image slip against encoder slip",
+                       [Note(f"{len(data.runs)} runs")])
+
+    with open_database(url)() as session:
+        data = gather(session, "bb2_sand_sample")
+        palette = Palette(data.loads, data.multipasses)
+        assert optional_sections(session, data, palette) == []  # nothing registered today
+        register(Extension("no-data", lambda session, data, palette: None))
+        register(Extension("image-slip", with_data))
+        try:
+            found = optional_sections(session, data, palette)
+            assert [s.anchor for s in found] == ["image-slip"] and calls == ["bb2_sand_sample"]
+            text = write_report(url, tmp_path / "r.html", quiet=True).read_text()
+        finally:
+            unregister("no-data")
+            unregister("image-slip")
+    assert '<section id="image-slip"><h2>Image slip against encoder slip</h2>' in text
+    assert "20 runs" in text and '<a href="#image-slip">' in text
+    assert "Image slip" not in small[2]
+
+
+def test_page_paths_one_campaign_keeps_the_name_several_get_a_suffix():
+    assert page_paths("out/report.html", ["c1"]) == {"c1": Path("out/report.html")}
+    paths = page_paths("out/report.html", ["lab A/2026", "lab A 2026", "b"])
+    assert paths["b"] == Path("out/report-b.html")
+    assert paths["lab A/2026"] == Path("out/report-lab_A_2026.html")
+    assert len(set(paths.values())) == 3
+
+
+def test_cli_writes_one_page_per_campaign(small, tmp_path, capsys, fast_timeseries):
+    url = _copy_db(small[0], tmp_path)
+    with open_database(url).begin() as session:
+        second = Campaign(name="second run-in")
+        session.add(second)
+        session.flush()
+        moved = [r.id for r in session.scalars(select(Run).where(Run.run_id.like("L120%")))]
+        session.execute(update(Run).where(Run.id.in_(moved)).values(campaign_id=second.id))
+        session.execute(update(TestCondition).where(TestCondition.id.in_(
+            select(Run.condition_id).where(Run.id.in_(moved)))).values(campaign_id=second.id))
+        assert campaign_names(session) == ["bb2_sand_sample", "second run-in"]
+    assert _cli(["--db", url, "-o", str(tmp_path / "r.html"), "--json", "--quiet"]) == 0
+    out, err = capsys.readouterr()
+    pages = json.loads(out)
+    assert [p["campaign"] for p in pages] == ["bb2_sand_sample", "second run-in"]
+    assert [Path(p["path"]).name for p in pages] == ["r-bb2_sand_sample.html",
+                                                     "r-second_run-in.html"]
+    assert all(Path(p["path"]).stat().st_size == p["bytes"] for p in pages) and err == ""
+    second_page = Path(pages[1]["path"]).read_text()
+    assert "L120_MP0_SC_s+003" in second_page and "L070_MP0_FS" not in second_page
+    # --campaign: that page only, to -o itself
+    assert _cli(["--db", url, "-o", str(tmp_path / "one.html"), "--campaign",
+                 "second run-in"]) == 0
+    assert "second run-in" in capsys.readouterr().out and (tmp_path / "one.html").is_file()
+    with pytest.raises(LookupError, match="name one with --campaign"):
+        write_report(url, tmp_path / "x.html")
+
+
+@pytest.mark.parametrize("case", ["missing file", "unknown campaign", "empty database"])
+def test_cli_errors_are_one_line_with_what_to_do(small, tmp_path, capsys, case):
+    url = {"missing file": f"sqlite:///{tmp_path / 'none.sqlite'}",
+           "unknown campaign": small[0], "empty database": None}[case]
+    if url is None:
+        url = f"sqlite:///{tmp_path / 'empty.sqlite'}"
+        open_database(url)
+    argv = ["--db", url, "-o", str(tmp_path / "r.html")]
+    if case == "unknown campaign":
+        argv += ["--campaign", "nope"]
+    assert _cli(argv) == exit_codes.BAD_INPUT
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("swtlab report: ")
+    assert {"missing file": "run swtlab process", "unknown campaign": "bb2_sand_sample",
+            "empty database": "run swtlab process first"}[case] in err
+    assert not (tmp_path / "r.html").exists() and not (tmp_path / "none.sqlite").exists()
