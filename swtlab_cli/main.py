@@ -12,7 +12,8 @@ import sys
 
 from swtlab_cli import exit_codes
 
-SUBCOMMANDS = ["inspect", "process", "results", "export", "wpm", "sim", "track_slip"]
+SUBCOMMANDS = ["inspect", "process", "results", "export", "wpm", "report", "sim",
+               "track_slip"]
 
 
 def _version() -> str:
