@@ -51,6 +51,8 @@ def _naive_run(path: Path) -> dict[str, tuple[float, float]]:
         for record in reader.iter_metadata():
             metadata[record.name] = record.metadata
         for _schema, channel, message in reader.iter_messages():
+            if channel.topic.startswith("/camera/"):
+                continue
             block = json.loads(message.data)
             for i in range(len(block["t_ns"])):
                 samples.setdefault(channel.topic, []).append(
