@@ -27,13 +27,17 @@ demo: $(STAMP)
 	$(BIN)/swtlab export --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/wpm.csv
 	$(BIN)/swtlab wpm query $(OUT)/wpm.csv --load 120 --dp 25 --multipass 0
 	$(BIN)/swtlab report --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/report.html
+	$(BIN)/swtlab gap --measured sqlite:///$(OUT)/swtlab.sqlite \
+	    --sim terramechanics/models/bb2_sand.toml --json $(OUT)/gap.json --html $(OUT)/gap.html
 	@echo "results: report $(OUT)/report.html (open it in a browser), database $(OUT)/swtlab.sqlite,"
-	@echo "         one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv"
+	@echo "         one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv,"
+	@echo "         sim-to-real gap report in $(OUT)/gap.html"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
+	$(BIN)/python -m pip install -q -e '.[bench]'
 	$(BIN)/python -m bench
 
 sample-data: $(STAMP)

@@ -13,7 +13,7 @@ import sys
 from swtlab_cli import exit_codes
 
 SUBCOMMANDS = ["inspect", "process", "results", "export", "wpm", "report", "sim",
-               "track_slip"]
+               "track_slip", "flow", "gap", "gap_bench"]
 
 
 def _version() -> str:

@@ -1,0 +1,9 @@
+"""Sim-to-real gap diagnosis (docs/gap-report.md): where the simulation misses the measured
+wheel, which unmodelled effect explains it, how far the gap shrinks once it is added.
+
+Modules: ``measured`` (measured points: database, WPM CSV, CMU smooth_runs.csv),
+``simulated`` (model TOML or a simulator's WPM CSV with model corrections), ``candidates``,
+``fit``, ``crossval``, ``decide``, ``discriminate``, ``shrink``, ``regions``, ``report``,
+``diagnose`` (the pure pipeline), ``api`` (files in, report out), ``calibrate`` (base-model
+soil fit), ``bench`` (the blind gap-bench).
+"""

@@ -1,0 +1,228 @@
+"""The blind gap-bench: campaigns from the model with a hidden effect set, diagnosed through
+the full chain by separate processes that never see the labels, then scored.
+
+Layout of the work folder::
+
+    sim.toml                      the simulation given to every diagnosis (base model)
+    c000/campaign/...             raw runs of campaign 0 (all a diagnosis can read)
+    c000/swtlab.sqlite            `swtlab process` output
+    c000/gap.json                 `swtlab gap` report
+    labels/labels.json            hidden effect sets and strengths (only the scorer reads it)
+    labels/c000/truth/...         the testbed's per-run truth, moved out of the campaign
+
+Each campaign: loads x slips x multipass {0, 1} x gravity {9.81, 3.71}, so that every effect
+has the contrast it needs (docs/gap-report.md, "Identifiability").
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import terramechanics as tm
+from sim_gap.vocabulary import EFFECT_NAMES
+
+STANDARD_GRAVITY_MPS2 = 9.80665
+MARS_GRAVITY_MPS2 = 3.71
+#: hidden effect strengths are drawn uniformly in these ranges
+STRENGTHS = {
+    "grousers": {"shear_radius_factor": (0.3, 1.0)},
+    "slip_sinkage": {"n1": (0.3, 0.8)},
+    "reduced_gravity": {"bearing_exponent": (0.6, 1.5)},
+    "wheel_flexibility": {"radial_stiffness_n_m": (15e3, 60e3),
+                          "hysteresis_coefficient": (0.015, 0.04)},
+    "multipass": {"stiffness_gain_per_pass": (0.15, 0.5)},
+    "bulldozing": {"coefficient": (0.05, 0.5)},
+}
+
+
+@dataclass(frozen=True)
+class Design:
+    """Conditions of every bench campaign; ``duration_s`` of each run."""
+
+    loads_n: tuple[float, ...] = (80.0, 180.0, 300.0)
+    slips: tuple[float, ...] = (0.1, 0.25, 0.4, 0.55, 0.7)
+    multipass: tuple[int, ...] = (0, 1)
+    gravity_mps2: tuple[float, ...] = (STANDARD_GRAVITY_MPS2, MARS_GRAVITY_MPS2)
+    duration_s: float = 60.0
+
+
+FAST_DESIGN = Design(loads_n=(80.0, 250.0), slips=(0.15, 0.4, 0.65), duration_s=50.0)
+
+
+def base_model() -> tm.WheelModel:
+    """The simulation every diagnosis gets: the shipped bb2_sand wheel and soil, no effects."""
+    model = tm.shipped_model("bb2_sand")
+    return model.with_effects(**{name: False for name in tm.EFFECTS})
+
+
+def draw_truth(rng: np.random.Generator) -> tuple[tm.WheelModel, dict]:
+    """A hidden truth: soil perturbed (k_phi x lognormal 25 %, friction angle +-1.5 deg
+    normal, K x lognormal 20 %) and none, one or two effects (a third each) at random
+    strengths. Returns the model and its label."""
+    n_effects = int(rng.integers(0, 3))
+    effects = sorted(rng.choice(EFFECT_NAMES, size=n_effects, replace=False).tolist(),
+                     key=EFFECT_NAMES.index)
+    params = {e: {k: float(rng.uniform(*r)) for k, r in STRENGTHS[e].items()} for e in effects}
+    soil = base_model().soil
+    soil_values = {"kphi": soil.kphi * float(np.exp(rng.normal(0, 0.25))),
+                   "friction_angle_deg": soil.friction_angle_deg + float(rng.normal(0, 1.5)),
+                   "shear_modulus_m": soil.shear_modulus_m * float(np.exp(rng.normal(0, 0.2)))}
+    model = base_model().with_soil(**soil_values).with_effects(**params)
+    return model, {"effects": effects, "parameters": params, "soil": soil_values}
+
+
+def conditions(design: Design):
+    from virtual_testbed import RunCondition
+
+    out = []
+    for g in design.gravity_mps2:
+        for mp in design.multipass:
+            for load in design.loads_n:
+                for s in design.slips:
+                    out.append(RunCondition(f"r{len(out):03d}", "speed_control", load, mp, s,
+                                            gravity_mps2=g))
+    return out
+
+
+def _generate(job) -> None:
+    """One campaign's raw runs; its truth folder is moved out of the campaign."""
+    from virtual_testbed import Testbed, generate_campaign
+
+    workdir, name, truth, seed, design = job
+    out = workdir / name
+    generate_campaign(out, conditions(design), seed=seed, duration_s=design.duration_s,
+                      testbed=Testbed(law=tm.ModelLaw(truth), campaign=name))
+    (workdir / "labels" / name).mkdir(parents=True, exist_ok=True)
+    shutil.move(str(out / "truth"), str(workdir / "labels" / name / "truth"))
+
+
+def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
+                   workers: int = 2) -> Path:
+    """Write ``n`` campaigns and the labels file; return the labels path."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    tm.save_model(base_model(), workdir / "sim.toml")
+    rng = np.random.default_rng(seed)
+    truths = [draw_truth(rng) for _ in range(n)]
+    jobs = [(workdir, f"c{i:03d}", truth, seed * 1000 + i, design)
+            for i, (truth, _) in enumerate(truths)]
+    with ProcessPoolExecutor(workers) as pool:
+        list(pool.map(_generate, jobs))
+    labels = {f"c{i:03d}": label for i, (_, label) in enumerate(truths)}
+    path = workdir / "labels" / "labels.json"
+    path.write_text(json.dumps(labels, indent=1) + "\n")
+    return path
+
+
+def diagnose_campaign(workdir: Path, name: str, boot: int) -> float:
+    """``swtlab process`` then ``swtlab gap`` in separate processes that are given the raw
+    campaign folder, the database and the simulation only. Returns the seconds taken."""
+    start = time.perf_counter()
+    db = f"sqlite:///{workdir / name / 'swtlab.sqlite'}"
+    cli = [sys.executable, "-m", "swtlab_cli.main"]
+    subprocess.run(cli + ["process", str(workdir / name / "campaign"), "--db", db, "--quiet"],
+                   check=True, capture_output=True)
+    subprocess.run(cli + ["gap", "--measured", db, "--sim", str(workdir / "sim.toml"),
+                          "--json", str(workdir / name / "gap.json"), "--boot", str(boot)],
+                   check=True, capture_output=True)
+    return time.perf_counter() - start
+
+
+def _label(effects) -> str:
+    if isinstance(effects, str):
+        return effects
+    return "+".join(effects) if effects else "none"
+
+
+def score(labels_path: Path, workdir: Path) -> dict:
+    """Compare each campaign's verdict with its hidden label (the only reader of labels)."""
+    labels = json.loads(Path(labels_path).read_text())
+    rows = []
+    for name, label in sorted(labels.items()):
+        report = json.loads((workdir / name / "gap.json").read_text())
+        verdict = report["verdict"]
+        hidden = label["effects"]
+        called = None if verdict == "inconclusive" else sorted(verdict, key=EFFECT_NAMES.index)
+        shrink = report["shrink_pct"]
+        rows.append({"campaign": name, "hidden": hidden, "called": called,
+                     "class": ("none", "single", "pair")[len(hidden)],
+                     "exact": called == hidden,
+                     "confident_wrong": called is not None and called != hidden,
+                     "mean_shrink_pct": float(np.mean(list(shrink.values()))) if shrink else None})
+    out = {"n": len(rows), "by_class": {}, "per_effect": {}, "confusion": {}}
+    for cls in ("none", "single", "pair"):
+        sub = [r for r in rows if r["class"] == cls]
+        out["by_class"][cls] = {"n": len(sub), "exact": sum(r["exact"] for r in sub),
+                                "exact_share": (sum(r["exact"] for r in sub) / len(sub))
+                                if sub else None,
+                                "inconclusive": sum(r["called"] is None for r in sub),
+                                "confident_wrong": sum(r["confident_wrong"] for r in sub)}
+    for e in EFFECT_NAMES:
+        tp = sum(r["called"] is not None and e in r["called"] and e in r["hidden"] for r in rows)
+        fp = sum(r["called"] is not None and e in r["called"] and e not in r["hidden"]
+                 for r in rows)
+        fn = sum(e in r["hidden"] and (r["called"] is None or e not in r["called"]) for r in rows)
+        out["per_effect"][e] = {"tp": tp, "fp": fp, "fn": fn,
+                                "precision": tp / (tp + fp) if tp + fp else None,
+                                "recall": tp / (tp + fn) if tp + fn else None}
+    for r in rows:
+        called = "inconclusive" if r["called"] is None else _label(r["called"])
+        row = out["confusion"].setdefault(_label(r["hidden"]), {})
+        row[called] = row.get(called, 0) + 1
+    effect_rows = [r for r in rows if r["called"] and r["mean_shrink_pct"] is not None]
+    out.update({
+        "exact_share": sum(r["exact"] for r in rows) / max(len(rows), 1),
+        "inconclusive_share": sum(r["called"] is None for r in rows) / max(len(rows), 1),
+        "confident_wrong_share": sum(r["confident_wrong"] for r in rows) / max(len(rows), 1),
+        "mean_shrink_pct": float(np.mean([r["mean_shrink_pct"] for r in effect_rows]))
+        if effect_rows else None,
+        "campaigns": rows})
+    return out
+
+
+def format_score(s: dict) -> str:
+    lines = [f"campaigns: {s['n']}"]
+    for cls, v in s["by_class"].items():
+        share = "n/a" if v["exact_share"] is None else f"{100 * v['exact_share']:.0f} %"
+        lines.append(f"  {cls:6s} n={v['n']:3d} exact {share:>6s}  inconclusive "
+                     f"{v['inconclusive']}  confident-wrong {v['confident_wrong']}")
+    lines.append(f"exact-set accuracy {100 * s['exact_share']:.0f} %, inconclusive "
+                 f"{100 * s['inconclusive_share']:.0f} %, confident wrong "
+                 f"{100 * s['confident_wrong_share']:.0f} %")
+    shrink = s["mean_shrink_pct"]
+    lines.append("mean shrink (confident effect calls): "
+                 + ("n/a" if shrink is None else f"{shrink:.1f} %"))
+    lines.append("per effect: precision / recall")
+    for e, v in s["per_effect"].items():
+        fmt = lambda x: "n/a" if x is None else f"{x:.2f}"  # noqa: E731
+        lines.append(f"  {e:18s} {fmt(v['precision'])} / {fmt(v['recall'])}  "
+                     f"(tp {v['tp']} fp {v['fp']} fn {v['fn']})")
+    lines.append("confusion (hidden -> called: count):")
+    for hidden, called in sorted(s["confusion"].items()):
+        lines.append(f"  {hidden}: " + ", ".join(f"{k} {v}" for k, v in sorted(called.items())))
+    return "\n".join(lines)
+
+
+def run_bench(n: int, seed: int, workdir: Path, design: Design = Design(), jobs: int = 2,
+              boot: int = 50) -> dict:
+    """Generate, diagnose (``jobs`` campaigns at a time, each in its own processes), score."""
+    t0 = time.perf_counter()
+    labels = make_campaigns(n, seed, workdir, design, jobs)
+    t1 = time.perf_counter()
+    names = [f"c{i:03d}" for i in range(n)]
+    with ThreadPoolExecutor(jobs) as pool:
+        seconds = list(pool.map(lambda name: diagnose_campaign(workdir, name, boot), names))
+    t2 = time.perf_counter()
+    out = score(labels, workdir)
+    out["timing_s"] = {"generate": t1 - t0, "process_and_diagnose": t2 - t1,
+                       "per_campaign_mean": float(np.mean(seconds)), "jobs": jobs}
+    (workdir / "score.json").write_text(json.dumps(out, indent=1) + "\n")
+    return out

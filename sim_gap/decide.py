@@ -1,0 +1,104 @@
+"""Ranking of the candidates and the verdict.
+
+Rule (a one-standard-error rule, Breiman et al. 1984 / Hastie, Tibshirani & Friedman 2009
+sec. 7.10, on paired per-run held-out losses):
+
+1. each candidate's held-out loss per run (mean squared standardised residual over its
+   folds and quantities); the best candidate has the lowest mean;
+2. a candidate is *tied* with the best when its paired mean excess of ``log(1 + loss)``
+   over the best is within ``Z_TIE`` standard errors, or below ``MIN_LOG_EXCESS`` (no
+   practical difference, however consistent);
+3. the chosen one is the simplest tied candidate (fewest effects, then fewest parameters,
+   then lowest loss);
+4. it is a confident call only if (a) no other tied candidate has as few effects but a
+   different set, (b) it beats soil-only recalibration by ``Z_CONFIDENT`` standard errors
+   (when it has an effect) and by ``MIN_GAIN`` of its loss, and (c) its held-out loss stays
+   below ``UNEXPLAINED_LOSS`` (else an effect outside the candidates is at work);
+   otherwise the verdict is ``inconclusive`` with the reason and the test that separates
+   the leaders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sim_gap.crossval import CrossValidated
+
+Z_TIE = 2.0
+#: a mean excess of log(1 + loss) below this is no practical difference (2 % of 1 + loss)
+MIN_LOG_EXCESS = 0.02
+Z_CONFIDENT = 4.0
+MIN_GAIN = 0.25
+UNEXPLAINED_LOSS = 9.0
+
+
+def paired_z(worse: np.ndarray, better: np.ndarray) -> float:
+    """Paired z over runs of ``log(1 + worse) - log(1 + better)`` (+inf when every run
+    differs by the same positive amount). The log makes a loss ratio, not a few runs with
+    large losses, decide: a candidate that cuts every run's loss tenfold is far ahead even
+    on a handful of runs."""
+    d = np.log1p(worse) - np.log1p(better)
+    se = d.std(ddof=1) / np.sqrt(d.size) if d.size > 1 else 0.0
+    mean = d.mean()
+    if se <= 1e-12:
+        return 0.0 if abs(mean) <= 1e-12 else float(np.sign(mean) * np.inf)
+    return float(mean / se)
+
+
+def rank(results: dict[str, CrossValidated], n_points: int) -> list[dict]:
+    """Candidates sorted by held-out loss, each with its score, AICc, parameters and its
+    paired z against the best."""
+    losses = {label: cv.run_losses(n_points) for label, cv in results.items()}
+    order = sorted(losses, key=lambda k: losses[k].mean())
+    best = losses[order[0]]
+    out = []
+    for label in order:
+        cv = results[label]
+        out.append({"label": label, "effects": list(cv.full.candidate.effects),
+                    "n_params": cv.full.n_params,
+                    "held_out_score": float(np.sqrt(losses[label].mean())),
+                    "held_out_loss": float(losses[label].mean()),
+                    "z_vs_best": paired_z(losses[label], best) if label != order[0] else 0.0,
+                    "aicc": float(cv.full.aicc), "parameters": cv.full.values,
+                    "held_out_run_losses": losses[label].tolist(),
+                    "fold_parameters": {name: v for name, _, _, v in cv.held_out}})
+    return out
+
+
+def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
+    """Verdict from the ranking (see the module docstring). Returns ``verdict`` (list of
+    effects or ``"inconclusive"``), ``chosen`` (label), ``leaders`` (labels to separate when
+    inconclusive) and ``reason``."""
+    best = losses[ranked[0]["label"]]
+    tied = [c for c in ranked if c["z_vs_best"] <= Z_TIE
+            or np.mean(np.log1p(losses[c["label"]]) - np.log1p(best)) < MIN_LOG_EXCESS]
+    chosen = min(tied, key=lambda c: (len(c["effects"]), c["n_params"], c["held_out_loss"]))
+    rivals = [c for c in tied if len(c["effects"]) == len(chosen["effects"])
+              and c["label"] != chosen["label"]]
+    soil = losses["soil_only"]
+    mine = losses[chosen["label"]]
+    z_soil = paired_z(soil, mine)
+    gain = 1.0 - mine.mean() / soil.mean() if soil.mean() > 0 else 0.0
+    out = {"chosen": chosen["label"], "z_vs_soil_only": z_soil, "gain_vs_soil_only": gain}
+    if rivals:
+        rival = min(rivals, key=lambda c: c["held_out_loss"])
+        return {**out, "verdict": "inconclusive", "leaders": [chosen["label"], rival["label"]],
+                "reason": f"{chosen['label']} and {rival['label']} explain the held-out data "
+                          f"equally well (paired difference {rival['z_vs_best']:.1f} SE "
+                          "from the best)"}
+    if chosen["effects"] and (z_soil < Z_CONFIDENT or gain < MIN_GAIN):
+        return {**out, "verdict": "inconclusive", "leaders": [chosen["label"], "soil_only"],
+                "reason": f"{chosen['label']} improves on soil-only recalibration by only "
+                          f"{z_soil:.1f} SE ({100 * gain:.0f} % of the held-out loss)"}
+    if chosen["held_out_loss"] > UNEXPLAINED_LOSS:
+        return {**out, "verdict": "inconclusive", "leaders": [], "unexplained": True,
+                "reason": f"the best explanation ({chosen['label']}) leaves a held-out gap "
+                          f"of {np.sqrt(chosen['held_out_loss']):.1f} sigma RMS: an effect "
+                          "outside the candidate set, or more than two missing effects"}
+    return {**out, "verdict": list(chosen["effects"]), "leaders": [chosen["label"]],
+            "reason": "no missing effect: soil recalibration explains the data"
+                      if not chosen["effects"] else
+                      f"{chosen['label']} beats soil-only recalibration by {z_soil:.1f} SE "
+                      f"({100 * gain:.0f} % of the held-out loss) and every rival of the "
+                      "same size by more than "
+                      f"{Z_TIE:g} SE"}

@@ -1,0 +1,123 @@
+"""One gap diagnosis: where (residual map), which (candidates, held-out ranking, verdict) and
+how far (held-out RMSE before and after). Pure: points and a simulation in, a dict out."""
+
+from __future__ import annotations
+
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from sim_gap import candidates as cands
+from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
+from sim_gap.decide import decide, rank
+from sim_gap.discriminate import separating_test
+from sim_gap.fit import quantities_of, sigmas
+from sim_gap.regions import largest_gap, residual_map
+from sim_gap.shrink import shrink
+from sim_gap.simulated import Simulated
+
+#: a standardised prediction change below this (max over points) makes an effect untestable
+TESTABLE_SIGMA = 0.2
+#: what each effect needs from a campaign to show (for the untestable list)
+CONTRAST_NEEDED = {"multipass": "a second multipass level",
+                   "reduced_gravity": "a gravity level other than the reference 9.81 m/s^2",
+                   "grousers": "a wheel with grousers (grouser_count, grouser_height_m > 0)",
+                   "slip_sinkage": "several slips", "wheel_flexibility": "a flexible wheel",
+                   "bulldozing": "measurable sinkage"}
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``max_nfev``/``fold_nfev``: evaluations of a full / a fold fit; ``n_boot``: bootstrap
+    replicates; ``jobs``: worker processes for the candidate fits."""
+
+    max_nfev: int = 40
+    fold_nfev: int = 12
+    n_boot: int = 200
+    jobs: int = 1
+    seed: int = 0
+
+
+def testable(sim: Simulated, points: pd.DataFrame, effects: list[str]
+             ) -> tuple[list[str], dict[str, str]]:
+    """Split ``effects`` into those that change a prediction at these conditions and the
+    others (with what the campaign would need)."""
+    sig = sigmas(points, sim.radius_m)
+    base = sim.predict(points, {})
+    keep, dropped = [], {}
+    for name in effects:
+        values = {p.name: p.start for p in cands.effect_params(name)}
+        pred = sim.predict(points, values)
+        change = max(float(np.nanmax(np.abs(pred[q] - base[q]) / sig[q]))
+                     for q in quantities_of(points))
+        if change >= TESTABLE_SIGMA:
+            keep.append(name)
+        else:
+            dropped[name] = f"no effect at these conditions; needs {CONTRAST_NEEDED[name]}"
+    return keep, dropped
+
+
+def _cv(args) -> CrossValidated:
+    sim, c, points, sig, settings, start = args
+    return cross_validate(sim, c, points, sig, start, max_nfev=settings.max_nfev,
+                          fold_nfev=settings.fold_nfev)
+
+
+def _pair_start(c: cands.Candidate, singles: dict[str, CrossValidated]) -> dict[str, float]:
+    """Start of a pair's fit: the better single's fitted values plus the other effect's
+    fitted strength."""
+    fits = sorted((singles[e] for e in c.effects), key=lambda cv: cv.full.chi2)
+    return {**fits[1].full.values, **fits[0].full.values}
+
+
+def _run_all(sim, candidate_list, points, sig, settings, starts=None
+             ) -> dict[str, CrossValidated]:
+    starts = starts or [None] * len(candidate_list)
+    jobs = [(sim, c, points, sig, settings, s) for c, s in zip(candidate_list, starts)]
+    if settings.jobs > 1 and len(jobs) > 1:
+        with ProcessPoolExecutor(settings.jobs) as pool:
+            done = list(pool.map(_cv, jobs))
+    else:
+        done = [_cv(j) for j in jobs]
+    return {c.label: cv for c, cv in zip(candidate_list, done)}
+
+
+def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = None,
+             settings: Settings | None = None) -> dict:
+    """The gap report's content (docs/gap-report.md) for measured ``points`` against ``sim``;
+    ``effects``: the candidate effects (default: every effect the simulation lacks)."""
+    settings = settings or Settings()
+    asked = [e for e in (effects or sim.missing_effects()) if e in sim.missing_effects()]
+    effects_ok, untestable = testable(sim, points, asked)
+    sig = sigmas(points, sim.radius_m)
+    n = len(points)
+    results = _run_all(sim, cands.singles(sim.model, effects_ok), points, sig, settings)
+    pairs = cands.pairs(sim.model, effects_ok)
+    results.update(_run_all(sim, pairs, points, sig, settings,
+                            [_pair_start(c, results) for c in pairs]))
+    ranked = rank(results, n)
+    losses = {label: cv.run_losses(n) for label, cv in results.items()}
+    decision = decide(ranked, losses)
+    if untestable and decision["verdict"] == []:
+        decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
+                               "out: " + ", ".join(sorted(untestable)))
+    regions = residual_map(points, sim.predict(points, {}),
+                           sim.predict(points, results["soil_only"].full.values), sim.radius_m)
+    if decision["verdict"] == "inconclusive" and decision["leaders"]:
+        a, b = (results[label].full.values for label in decision["leaders"])
+        decision["separating_test"] = separating_test(sim, points, a, b)
+    elif decision["verdict"] == "inconclusive":
+        decision["separating_test"] = largest_gap(regions)
+    after_label = decision["chosen"]
+    return {
+        "verdict": decision["verdict"], "decision": decision, "candidates": ranked,
+        "untestable_effects": untestable, "contrasts": contrasts(points),
+        "folds": [name for name, _ in folds(points)],
+        "shrink": shrink(sim, points, results["soil_only"], results[after_label],
+                         settings.n_boot, settings.seed),
+        "regions": regions,
+        "n_points": n, "quantities": quantities_of(points),
+        "sinkage_relative": bool(points.attrs.get("sinkage_relative", False)),
+    }

@@ -1,0 +1,117 @@
+"""The measured side: one row per run (or curve sample) with its conditions, slip and each
+quantity's mean and standard error.
+
+Columns: ``run_id``, ``load_set_n`` (grouping), ``load_n`` (measured wheel load, used in the
+model), ``multipass``, ``gravity_mps2``, ``slip`` and ``<q>``, ``<q>_se`` for the quantities
+of :data:`sim_gap.vocabulary.QUANTITIES` that the source has. ``attrs``: ``source`` (text),
+``sinkage_relative`` (True when only sinkage differences are known, e.g. a hub height
+without an absolute zero).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from fitting.polynomial import horner
+from fitting.table import from_run_results
+from sim_gap.vocabulary import QUANTITIES
+from wpm_export import WheelPerformanceModule
+
+STANDARD_GRAVITY_MPS2 = 9.80665
+#: slip grid on which WPM curves are sampled (inside each curve's range)
+WPM_SLIP_POINTS = 9
+
+
+def _finish(table: pd.DataFrame, source: str, sinkage_relative: bool = False) -> pd.DataFrame:
+    cols = ["run_id", "load_set_n", "load_n", "multipass", "gravity_mps2", "slip"]
+    for q in QUANTITIES:
+        if q in table and table[q].notna().any():
+            cols += [q, f"{q}_se"]
+    out = table[cols].reset_index(drop=True)
+    out["multipass"] = out["multipass"].astype(int)
+    out.attrs.update(source=source, sinkage_relative=sinkage_relative)
+    return out
+
+
+def from_results_table(results: pd.DataFrame, source: str = "results") -> pd.DataFrame:
+    """Measured points from the table of ``latest_results`` / ``swtlab results`` (runs with
+    status ``ok``, speed control, free sled or towed)."""
+    table = from_run_results(results)
+    table = table.dropna(subset=["slip"])
+    table = table.assign(load_set_n=table["load_n"].astype(float),
+                         load_n=table.get("wheel_load_n", table["load_n"]).astype(float),
+                         gravity_mps2=table["gravity_mps2"].fillna(STANDARD_GRAVITY_MPS2))
+    if table.empty:
+        raise ValueError(f"{source}: no processed run with status ok")
+    return _finish(table, source)
+
+
+def from_database(url: str) -> pd.DataFrame:
+    """Measured points of every processed run in the swtlab database at ``url``."""
+    from traceability import open_database
+    from traceability.queries import latest_results
+
+    with open_database(url)() as session:
+        return from_results_table(latest_results(session), source=url)
+
+
+def from_wpm(wpm: WheelPerformanceModule, gravity_mps2: float | None = None) -> pd.DataFrame:
+    """Points sampled from WPM curves: each (soil, wheel, multipass, load) curve set at
+    :data:`WPM_SLIP_POINTS` slips over its range; the curve's RMSE is the uncertainty.
+    Gravity: ``gravity_mps2``, else the header key ``gravity_mps2``, else standard."""
+    g = gravity_mps2 or float(wpm.header.get("gravity_mps2", STANDARD_GRAVITY_MPS2))
+    rows = []
+    for soil, wheel, mp in wpm.sets():
+        by_q = wpm._sets[(soil, wheel, mp)]  # noqa: SLF001 - the reader's own index
+        for load in sorted({load for curves in by_q.values() for load in curves}):
+            curves = {q: by_q[q][load] for q in QUANTITIES if load in by_q.get(q, {})}
+            lo = max(c.slip_min for c in curves.values())
+            hi = min(c.slip_max for c in curves.values())
+            for i, s in enumerate(np.linspace(lo, hi, WPM_SLIP_POINTS)):
+                row = {"run_id": f"{soil}/{wheel}/mp{mp}/{load:g}N/{i}", "load_set_n": load,
+                       "load_n": load, "multipass": mp, "gravity_mps2": g, "slip": s}
+                for q, c in curves.items():
+                    row[q] = float(horner(c.coefficients, s))
+                    row[f"{q}_se"] = max(c.rmse, 1e-9)
+                rows.append(row)
+    return _finish(pd.DataFrame(rows), wpm.source)
+
+
+def from_wpm_csv(path: str | Path, gravity_mps2: float | None = None) -> pd.DataFrame:
+    return from_wpm(WheelPerformanceModule.load(path), gravity_mps2)
+
+
+def from_cmu_smooth_runs(path: str | Path) -> pd.DataFrame:
+    """The CMU 3d-terramechanics ``smooth_runs.csv`` (Pavlov, CMU; see its README): the
+    straight-driving rows (slip angle 0). Drawbar pull = ``tractive_force_n``, load =
+    ``wheel_load_n``, sinkage = minus the hub height (``-hub_z_mm``/1000) and therefore
+    **relative** (unknown zero; the diagnosis profiles out its offset). The file gives
+    per-run standard deviations of the 70-75 s window, not standard errors: the SE used
+    is the std (a conservative stand-in, the samples being strongly autocorrelated)."""
+    raw = pd.read_csv(path)
+    raw = raw[raw["slip_angle_deg"] == 0].reset_index(drop=True)
+    table = pd.DataFrame({
+        "run_id": raw["run_file"].astype(str), "load_set_n": raw["wheel_load_n"].mean(),
+        "load_n": raw["wheel_load_n"], "multipass": 0, "gravity_mps2": STANDARD_GRAVITY_MPS2,
+        "slip": raw["slip"], "dp_n": raw["tractive_force_n"],
+        "dp_n_se": raw["tractive_force_std_n"], "sinkage_m": -raw["hub_z_mm"] / 1000.0,
+        "sinkage_m_se": np.maximum(raw["hub_z_std_mm"] / 1000.0, 1e-5)})
+    return _finish(table, str(path), sinkage_relative=True)
+
+
+def load_measured(source: str) -> pd.DataFrame:
+    """A database URL (``scheme://...``), a WPM CSV, or a CMU ``smooth_runs.csv``."""
+    if "://" in source:
+        return from_database(source)
+    path = Path(source)
+    if not path.exists():
+        raise FileNotFoundError(f"{source}: no such file (expected a database URL or a CSV)")
+    head = path.read_text(encoding="utf-8-sig")[:2000]
+    if head.startswith("# format:"):
+        return from_wpm_csv(path)
+    if "tractive_force_n" in head.splitlines()[0]:
+        return from_cmu_smooth_runs(path)
+    raise ValueError(f"{source}: neither a WPM CSV nor a CMU smooth_runs.csv")

@@ -1,0 +1,94 @@
+"""The simulated side: the built-in model from a TOML file, or a WPM CSV written by any
+simulator (DEM, FEM, SCM ...).
+
+For a WPM CSV an effect (or a soil recalibration) is added as the correction the built-in
+reference model computes for it at the same conditions:
+``sim + (model(theta, effects) - model(theta_0))``. For a model TOML the prediction is the
+model itself, ``model(theta, effects)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+import terramechanics as tm
+from sim_gap.vocabulary import QUANTITIES
+from wpm_export import WheelPerformanceModule
+
+
+@dataclass
+class Simulated:
+    """``model``: the built-in model (the simulation itself for a TOML; the reference model
+    that computes corrections for a WPM CSV); ``wpm``: the simulator's curves, if any."""
+
+    model: tm.WheelModel
+    wpm: WheelPerformanceModule | None = None
+    source: str = "<model>"
+    _base_cache: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def radius_m(self) -> float:
+        return self.model.wheel.radius_m
+
+    def missing_effects(self) -> list[str]:
+        """Effects of the vocabulary that the simulation does not have on (the candidates).
+        A WPM simulator is taken to have none of them."""
+        on = set() if self.wpm is not None else set(self.model.effects)
+        return [name for name in tm.EFFECTS if name not in on]
+
+    def _model_curves(self, model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
+        c = model.curves(points["load_n"].to_numpy(float), points["slip"].to_numpy(float),
+                         points["multipass"].to_numpy(float),
+                         points["gravity_mps2"].to_numpy(float))
+        return {q: c[q] for q in QUANTITIES}
+
+    def _wpm_curves(self, points: pd.DataFrame) -> dict[str, np.ndarray]:
+        out = {q: np.full(len(points), np.nan) for q in QUANTITIES}
+        for mp, idx in points.groupby("multipass").indices.items():
+            sub = points.iloc[idx]
+            values = self.wpm.at_slip(sub["slip"].to_numpy(float), sub["load_n"].to_numpy(float),
+                                      multipass=int(mp), allow_extrapolation=True)
+            for q, v in values.items():
+                if q in out:
+                    out[q][idx] = v
+        return out
+
+    def _base(self, points: pd.DataFrame) -> tuple[dict, dict]:
+        key = points[["load_n", "slip", "multipass", "gravity_mps2"]].to_numpy(float).tobytes()
+        if key not in self._base_cache:
+            self._base_cache.clear()
+            model0 = self._model_curves(self.model, points)
+            sim0 = self._wpm_curves(points) if self.wpm is not None else model0
+            self._base_cache[key] = (model0, sim0)
+        return self._base_cache[key]
+
+    def predict(self, points: pd.DataFrame, values: dict[str, float] | None = None
+                ) -> dict[str, np.ndarray]:
+        """Each quantity at every point with the dotted-name ``values`` changed (naming
+        ``effects.<name>.<param>`` switches that effect on)."""
+        values = values or {}
+        if self.wpm is None:
+            return self._model_curves(self.model.with_parameters(values), points)
+        model0, sim0 = self._base(points)
+        if not values:
+            return dict(sim0)
+        changed = self._model_curves(self.model.with_parameters(values), points)
+        return {q: sim0[q] + changed[q] - model0[q] for q in QUANTITIES}
+
+
+def load_simulated(source: str | Path, reference: str | Path | None = None) -> Simulated:
+    """A model TOML, or a WPM CSV with ``reference`` (a model TOML; default: the shipped
+    ``bb2_sand`` soil and wheel with every effect off) computing the corrections."""
+    path = Path(source)
+    if path.suffix.lower() == ".toml":
+        return Simulated(tm.load_model(path), source=str(path))
+    if reference is not None:
+        ref = tm.load_model(reference)
+    else:
+        ref = tm.shipped_model("bb2_sand")
+        ref = ref.with_effects(**{name: False for name in tm.EFFECTS})
+    return Simulated(ref, WheelPerformanceModule.load(path), source=str(path))

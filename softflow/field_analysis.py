@@ -1,0 +1,145 @@
+"""SOFT analysis of side-camera frames: wheel, flow, polar profiles, decay fits, grouser model.
+
+Pipeline (issue items 2-5): track the wheel (:mod:`softflow.wheel_detect`), mask it,
+measure and average the soil flow (:mod:`softflow.flow_engine`), go to the world
+frame and resolve about the axle (:mod:`softflow.polar`), fit ``k(beta)`` and
+``alpha3(beta)`` (:mod:`softflow.decay_fit`), and for a grousered wheel score the
+effective-radius models (:mod:`softflow.grouser_models`). Where ``eps_vol^P(beta)``
+is given, ``1/k = eps/alpha1 + alpha2/alpha1`` is regressed over beta (alpha1,
+alpha2 constant) to separate ``alpha1`` and ``alpha2``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from softflow.decay_fit import DecayFit, fit_decay
+from softflow.flow_engine import MeanField, average_flow
+from softflow.grouser_models import select_model
+from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
+from softflow.wheel_detect import WheelPose, soil_mask, track_wheel
+
+BIN_WIDTH_DEG = 10.0
+
+
+@dataclass
+class FlowResult:
+    """Everything measured on one frame range; ``to_dict()`` is what the database stores."""
+
+    px_per_m: float
+    t_s: np.ndarray
+    frame_range: tuple[int, int]
+    poses: list[WheelPose]
+    mean: MeanField
+    sled_velocity_mps: tuple[float, float]  # (x right, y down), image axes
+    beta_rad: np.ndarray
+    radial: list[DecayFit | None]
+    tangential: list[DecayFit | None]
+    profiles_r: list = field(default_factory=list)
+    profiles_t: list = field(default_factory=list)
+    grouser: dict | None = None
+    alpha12: dict | None = None
+    engine: str = "farneback"
+    source: str = ""
+
+    def to_dict(self) -> dict:
+        p0 = self.poses[0]
+        return {
+            "schema": "swtlab.softflow/1",
+            "source": self.source,
+            "frame_range": list(self.frame_range),
+            "t_s": [float(self.t_s[0]), float(self.t_s[-1])],
+            "pairs": len(self.t_s) - 1,
+            "engine": self.engine,
+            "px_per_m": self.px_per_m,
+            "outlier_fraction": self.mean.outlier_fraction,
+            "sled_velocity_mps": list(self.sled_velocity_mps),
+            "wheel": {"center_px_first": list(p0.center_px),
+                      "center_px_last": list(self.poses[-1].center_px),
+                      "radius_px": p0.radius_px, "grouser_count": p0.grouser_count,
+                      "grouser_height_px": p0.grouser_height_px},
+            "angle_convention": "beta: 0 at image right, counter-clockwise; velocities in the "
+                                "bin (world) frame about the axle, v_r outwards, v_theta along "
+                                "e_theta (theta from the downward vertical towards travel)",
+            "per_beta": [
+                {"beta_deg": float(np.rad2deg(b)),
+                 "k": r.to_dict() if r else None,
+                 "alpha3": t.to_dict() if t else None}
+                for b, r, t in zip(self.beta_rad, self.radial, self.tangential)],
+            "alpha1_alpha2": self.alpha12,
+            "grouser_model": self.grouser,
+        }
+
+
+def _rates(fits: list[DecayFit | None]) -> np.ndarray:
+    return np.array([f.rate_per_m if f and f.r2 > 0.5 else np.nan for f in fits])
+
+
+def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
+                   direction: int = 1, wheel_center_px: tuple[float, float] | None = None,
+                   wheel_radius_px: float | None = None, grouser_count: int | None = None,
+                   grouser_height_px: float | None = None, engine: str = "farneback",
+                   eps_vol_by_beta: np.ndarray | None = None,
+                   frame_range: tuple[int, int] | None = None, source: str = "") -> FlowResult:
+    """Run the whole SOFT analysis on grey frames of the stable phase (2 or more)."""
+    if len(frames) < 2:
+        raise ValueError("need at least two frames")
+    poses = track_wheel(frames, direction, wheel_center_px, wheel_radius_px, grouser_count,
+                        grouser_height_px)
+    masks = [soil_mask(frames[0].shape, poses[k]) & soil_mask(frames[0].shape, poses[k + 1])
+             for k in range(len(frames) - 1)]
+    mean = average_flow(frames, np.asarray(t_s, float), masks, engine)
+    center = tuple(np.mean([p.center_px for p in poses], axis=0))
+    r_px, beta, theta = polar_coordinates(frames[0].shape, center, direction)
+    v_cam = mean.velocity_px_per_s / px_per_m
+    sled = -far_field_velocity(v_cam, r_px)
+    v_r, v_t = resolve(v_cam + sled, theta, direction)
+    rim = poses[0].radius_px
+    r_min = rim + poses[0].grouser_height_px + 8.0
+    centres = beta_bins(BIN_WIDTH_DEG)
+    width = np.deg2rad(BIN_WIDTH_DEG)
+    prof_r = profiles(v_r, r_px, beta, centres, width, r_min)
+    prof_t = profiles(v_t, r_px, beta, centres, width, r_min)
+    fit = lambda p: fit_decay((p[0] - rim) / px_per_m, p[1], p[2])  # noqa: E731
+    radial = [fit(p) for p in prof_r]
+    tangential = [fit(p) for p in prof_t]
+    result = FlowResult(px_per_m, np.asarray(t_s, float),
+                        frame_range or (0, len(frames) - 1), poses, mean,
+                        (float(sled[0]), float(sled[1])), centres, radial, tangential,
+                        prof_r, prof_t, engine=engine, source=source)
+    if eps_vol_by_beta is not None:
+        k = _rates(radial)
+        ok = np.isfinite(k) & np.isfinite(eps_vol_by_beta)
+        if ok.sum() >= 3:
+            slope, intercept = np.polyfit(eps_vol_by_beta[ok], 1 / k[ok], 1)
+            result.alpha12 = {"alpha1_per_m": float(1 / slope),
+                              "alpha2": float(intercept / slope), "bins_used": int(ok.sum())}
+    if poses[0].grouser_count and poses[0].grouser_height_px > 0:
+        result.grouser = _grouser_selection(result, frames[0].shape, direction, r_min)
+    return result
+
+
+def _grouser_selection(result: FlowResult, shape: tuple[int, int], direction: int,
+                       r_min: float) -> dict:
+    """Per-pair samples (every 3rd pixel) in the world frame, scored per grouser model."""
+    keys = ("r_px", "theta", "bin", "wheel_angle", "v_r", "v_t")
+    parts = {k: [] for k in keys}
+    width = np.deg2rad(BIN_WIDTH_DEG)
+    for k, vel in enumerate(result.mean.pair_velocities_px_per_s):
+        pose = result.poses[k]
+        r_px, beta, theta = polar_coordinates(shape, pose.center_px, direction)
+        sub = (slice(None, None, 3), slice(None, None, 3))
+        v = vel[sub] / result.px_per_m + np.array(result.sled_velocity_mps)
+        ok = np.isfinite(v[..., 0]) & (r_px[sub] >= r_min) & (r_px[sub] <= r_min + 60)
+        vr, vt = resolve(v, theta[sub], direction)
+        b = np.floor((beta[sub] + np.pi) / width).astype(int) % len(result.beta_rad)
+        for key, arr in zip(keys, (r_px[sub], theta[sub], b,
+                                   np.full(r_px[sub].shape, pose.grouser_angle_rad), vr, vt)):
+            parts[key].append(arr[ok])
+    samples = {k: np.concatenate(v) for k, v in parts.items()}
+    p0 = result.poses[0]
+    return select_model(samples, p0.radius_px, p0.grouser_height_px, p0.grouser_count,
+                        {"r": _rates(result.radial), "t": _rates(result.tangential)},
+                        result.px_per_m)

@@ -1,0 +1,63 @@
+"""``swtlab gap --measured DB_URL_OR_CSV --sim MODEL_TOML_OR_WPM [--json F] [--html F]``:
+the sim-to-real gap diagnosis (docs/gap-report.md)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from swtlab_cli import exit_codes
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "gap", help="diagnose the sim-to-real gap: where, which missing effect, how far",
+        description="Residual map of measured against simulated drawbar pull, torque, sinkage "
+                    "and resistance; candidate explanations (soil recalibration, each missing "
+                    "effect, pairs) fitted and scored on held-out loads, multipass and gravity "
+                    "levels; a verdict (effects, none, or inconclusive with the test that "
+                    "would decide); held-out RMSE before and after. docs/gap-report.md.")
+    p.add_argument("--measured", required=True,
+                   help="database URL (swtlab process), WPM CSV, or CMU smooth_runs.csv")
+    p.add_argument("--sim", required=True, help="model TOML or a simulator's WPM CSV")
+    p.add_argument("--reference-model", help="model TOML computing effect corrections for a "
+                                             "WPM-CSV simulation (default: bb2_sand, no effects)")
+    p.add_argument("--effects", help="comma-separated candidate effects (default: all the "
+                                     "simulation lacks)")
+    p.add_argument("--json", help="write the report JSON here")
+    p.add_argument("--html", help="write the HTML report here")
+    p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
+    p.add_argument("--boot", type=int, default=200, help="bootstrap replicates (default 200)")
+    p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from sim_gap.api import run_gap
+    from sim_gap.diagnose import Settings
+    from sim_gap.vocabulary import EFFECT_NAMES
+
+    effects = None
+    if args.effects:
+        effects = [e.strip() for e in args.effects.split(",") if e.strip()]
+        unknown = sorted(set(effects) - set(EFFECT_NAMES))
+        if unknown:
+            print(f"swtlab gap: unknown effect(s) {unknown}; known: {list(EFFECT_NAMES)}",
+                  file=sys.stderr)
+            return exit_codes.USAGE
+    try:
+        report = run_gap(args.measured, args.sim, args.json, args.html, effects,
+                         args.reference_model,
+                         Settings(n_boot=args.boot, jobs=args.jobs, seed=args.seed))
+    except (OSError, ValueError, KeyError) as exc:
+        print(f"swtlab gap: {exc}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    verdict = report["verdict"]
+    print("verdict:", verdict if isinstance(verdict, str) else (", ".join(verdict) or "none"))
+    print("reason:", report["reason"])
+    if report.get("separating_test"):
+        print("test that would decide:", report["separating_test"]["test"])
+    for q, before in report["held_out_rmse_before"].items():
+        print(f"{q}: held-out RMSE {before:.4g} -> {report['held_out_rmse_after'][q]:.4g} "
+              f"({report['shrink_pct'][q]:.1f} % shrink)")
+    return exit_codes.OK

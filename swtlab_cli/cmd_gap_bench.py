@@ -1,0 +1,48 @@
+"""``swtlab gap-bench --n N --seed S``: the blind check of the gap diagnosis (sim_gap.bench)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+from pathlib import Path
+
+from swtlab_cli import exit_codes
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "gap-bench", help="blind check of `swtlab gap` on virtual campaigns with hidden effects",
+        description="Make N virtual-testbed campaigns, each from the model with a hidden effect "
+                    "set (none, one or two effects at random strengths); process and diagnose "
+                    "each in separate processes that never see the hidden labels; score the "
+                    "verdicts against the labels file (docs/gap-report.md).")
+    p.add_argument("--n", type=int, default=40, help="number of campaigns (default 40)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--workdir", type=Path, help="keep campaigns, reports and labels here "
+                                                "(default: a temporary folder)")
+    p.add_argument("--jobs", type=int, default=2, help="campaigns diagnosed at a time")
+    p.add_argument("--boot", type=int, default=50, help="bootstrap replicates per diagnosis")
+    p.add_argument("--fast", action="store_true",
+                   help="small campaigns (2 loads x 3 slips x 2 multipass x 2 gravity)")
+    p.add_argument("--json", type=Path, help="write the score JSON here")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from sim_gap.bench import FAST_DESIGN, Design, format_score, run_bench
+
+    if args.n < 1:
+        print("swtlab gap-bench: --n must be >= 1")
+        return exit_codes.USAGE
+    design = FAST_DESIGN if args.fast else Design()
+    with tempfile.TemporaryDirectory(prefix="gap-bench-") as tmp:
+        workdir = args.workdir or Path(tmp)
+        result = run_bench(args.n, args.seed, workdir, design, args.jobs, args.boot)
+    print(format_score(result))
+    t = result["timing_s"]
+    print(f"time: generate {t['generate']:.0f} s, process + diagnose "
+          f"{t['process_and_diagnose']:.0f} s ({t['jobs']} at a time)")
+    if args.json:
+        args.json.write_text(json.dumps(result, indent=1) + "\n")
+    return exit_codes.OK

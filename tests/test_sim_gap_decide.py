@@ -1,0 +1,144 @@
+"""Gap diagnosis on synthetic model data with injected effects: the decision rule, clear cases
+found, the untestable effect named with the contrast it needs, the separating test."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import terramechanics as tm
+from sim_gap.decide import decide, rank
+from sim_gap.diagnose import Settings, diagnose
+from sim_gap.discriminate import separating_test
+from sim_gap.simulated import Simulated
+
+BASE = tm.shipped_model("bb2_sand").with_effects(**{n: False for n in tm.EFFECTS})
+FAST = Settings(max_nfev=25, fold_nfev=8, n_boot=20)
+
+
+def synthetic_points(truth: tm.WheelModel, seed: int = 0, loads=(80.0, 180.0, 300.0),
+                     slips=(0.1, 0.3, 0.5, 0.7), multipass=(0, 1),
+                     gravity=(9.80665,)) -> pd.DataFrame:
+    """Model values with Gaussian noise of 0.5 % of the load (forces), 0.1 mm (sinkage)."""
+    rng = np.random.default_rng(seed)
+    grids = np.meshgrid(loads, slips, multipass, gravity, indexing="ij")
+    load, slip, mp, g = (a.ravel() for a in grids)
+    c = truth.curves(load, slip, mp, g)
+    points = pd.DataFrame({"run_id": [f"r{i}" for i in range(load.size)], "load_set_n": load,
+                           "load_n": load, "multipass": mp.astype(int), "gravity_mps2": g,
+                           "slip": slip})
+    noise = {"dp_n": 0.005 * load, "torque_nm": 0.005 * load * 0.125, "sinkage_m": 1e-4,
+             "resistance_n": 0.005 * load}
+    for q, sd in noise.items():
+        points[q] = c[q] + rng.normal(0.0, 1.0, load.size) * sd
+        points[f"{q}_se"] = 0.2 * np.broadcast_to(sd, load.shape)
+    points.attrs.update(source="synthetic", sinkage_relative=False)
+    return points
+
+
+TRUTH_SOIL = {"kphi": 1.8e7 * 1.3, "friction_angle_deg": 35.5}
+CANDIDATES = ["grousers", "slip_sinkage", "bulldozing"]
+
+
+@pytest.mark.parametrize("effects, expected", [
+    ({}, []),
+    ({"slip_sinkage": {"n1": 0.6}}, ["slip_sinkage"]),
+    ({"bulldozing": {"coefficient": 1.5}}, ["bulldozing"]),
+])
+def test_injected_effect_is_found(effects, expected):
+    truth = BASE.with_soil(**TRUTH_SOIL).with_effects(**effects)
+    report = diagnose(synthetic_points(truth), Simulated(BASE), CANDIDATES, FAST)
+    assert report["verdict"] == expected
+    assert report["folds"] == ["load=80", "load=180", "load=300"]
+    labels = [c["label"] for c in report["candidates"]]
+    assert set(labels) >= {"soil_only", "grousers", "slip_sinkage", "bulldozing"}
+    if expected:
+        chosen = next(c for c in report["candidates"] if c["label"] == expected[0])
+        soil = next(c for c in report["candidates"] if c["label"] == "soil_only")
+        assert chosen["held_out_score"] < 0.6 * soil["held_out_score"]
+        assert report["shrink"]["shrink_pct"]["dp_n"] > 40.0
+        assert report["shrink"]["shrink_pct"]["resistance_n"] > 40.0
+
+
+def test_multipass_on_one_level_is_untestable_with_the_contrast_it_needs():
+    truth = BASE.with_effects(multipass={"stiffness_gain_per_pass": 0.3})
+    points = synthetic_points(truth, multipass=(0,), slips=(0.2, 0.5))
+    report = diagnose(points, Simulated(BASE), ["multipass", "bulldozing"], FAST)
+    assert "multipass" in report["untestable_effects"]
+    assert "second multipass level" in report["untestable_effects"]["multipass"]
+    assert "neither found nor ruled out: multipass" in report["decision"]["reason"]
+    assert report["contrasts"] == {"load": 3, "multipass": 1, "gravity": 1}
+
+
+def test_without_the_contrast_the_call_is_inconclusive_with_a_test_to_run():
+    """Grousers on one load, drawbar pull only: slip-sinkage mimics them on four slips; the
+    diagnosis must not name either, and proposes the test that separates them."""
+    truth = BASE.with_soil(kphi=2.3e7).with_effects(grousers={"shear_radius_factor": 0.8})
+    points = synthetic_points(truth, loads=(180.0,), multipass=(0,))
+    points = points[["run_id", "load_set_n", "load_n", "multipass", "gravity_mps2", "slip",
+                     "dp_n", "dp_n_se"]]
+    points.attrs.update(source="synthetic", sinkage_relative=False)
+    report = diagnose(points, Simulated(BASE), ["grousers", "slip_sinkage"], FAST)
+    assert report["verdict"] == "inconclusive"
+    assert report["folds"][0].startswith("slip band")
+    assert "only 3.1 SE" in report["decision"]["reason"]
+    test = report["decision"]["separating_test"]
+    assert test["test"] == "add skid (braked) slips (-0.5, -0.2)"
+    assert test["separation_sigma"] > 2.0
+
+
+def test_separating_test_asks_for_the_missing_contrast():
+    points = synthetic_points(BASE, multipass=(0,), slips=(0.2, 0.5))
+    test = separating_test(Simulated(BASE), points, {},
+                           {"effects.multipass.stiffness_gain_per_pass": 0.4})
+    assert test["test"] == "run multipass level 1"
+    assert test["separation_sigma"] > 3.0
+
+
+def _fake(labels_losses: dict[str, np.ndarray]):
+    """rank/decide inputs without fits: a stand-in for CrossValidated."""
+
+    class Fit:
+        def __init__(self, label, n_params):
+            self.candidate = type("C", (), {"effects": () if label == "soil_only"
+                                            else tuple(label.split("+"))})()
+            self.n_params, self.aicc, self.values = n_params, 0.0, {}
+
+    class CV:
+        def __init__(self, label, losses):
+            self.full, self.losses, self.held_out = Fit(label, 3 + label.count("+") + 1), \
+                losses, []
+
+        def run_losses(self, n):
+            return self.losses
+
+    return {k: CV(k, v) for k, v in labels_losses.items()}
+
+
+def test_decide_tied_singles_are_inconclusive_and_clear_single_is_called():
+    rng = np.random.default_rng(1)
+    noise = lambda: rng.normal(0, 0.05, 40)  # noqa: E731
+    tied = {"soil_only": 6 + noise(), "grousers": 1 + noise(), "slip_sinkage": 1 + noise(),
+            "grousers+slip_sinkage": 1 + noise()}
+    ranked = rank(_fake(tied), 40)
+    out = decide(ranked, tied)
+    assert out["verdict"] == "inconclusive"
+    assert set(out["leaders"]) == {"grousers", "slip_sinkage"}
+    clear = dict(tied, slip_sinkage=3 + noise())
+    out = decide(rank(_fake(clear), 40), clear)
+    assert out["verdict"] == ["grousers"]
+    assert out["z_vs_soil_only"] > 50
+
+
+def test_decide_weak_gain_and_unexplained_gap_are_inconclusive():
+    rng = np.random.default_rng(2)
+    bull = 1.0 + rng.normal(0, 0.3, 30)
+    weak = {"soil_only": bull + 0.08 + rng.normal(0, 0.2, 30), "bulldozing": bull}
+    out = decide(rank(_fake(weak), 30), weak)
+    assert 2.0 < out["z_vs_soil_only"] < 4.0
+    assert out["verdict"] == "inconclusive" and out["leaders"] == ["bulldozing", "soil_only"]
+    big = {"soil_only": 400 + rng.normal(0, 1, 30), "bulldozing": 100 + rng.normal(0, 1, 30)}
+    out = decide(rank(_fake(big), 30), big)
+    assert out["verdict"] == "inconclusive" and out.get("unexplained")
+    assert "outside the candidate set" in out["reason"]

@@ -1,0 +1,96 @@
+"""softflow.field_analysis on renders: decay rates per beta, grouser model choice, CLI and JSON."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from softflow.field_analysis import analyse_frames
+from softflow.frames import load_frames
+from swtlab_cli.main import main
+from virtual_testbed.flow_render import (FlowScene, default_radial_decay_per_m,
+                                         default_tangential_decay_per_m, render_flow,
+                                         write_flow_render)
+
+
+@pytest.fixture(scope="module")
+def smooth_wheel():
+    scene = FlowScene(seed=5)
+    return scene, render_flow(scene, 10)
+
+
+def _contact(result):
+    beta = result.beta_rad
+    return (beta < -np.deg2rad(20)) & (beta > -np.deg2rad(160))
+
+
+def test_decay_rates_within_5_percent(smooth_wheel):
+    scene, r = smooth_wheel
+    res = analyse_frames(r.frames, r.t_s, scene.px_per_m)
+    contact = _contact(res)
+    theta = res.beta_rad + np.pi / 2
+    k = np.array([f.rate_per_m if f else np.nan for f in res.radial])
+    a3 = np.array([f.rate_per_m if f else np.nan for f in res.tangential])
+    k_bins = contact & (np.abs(np.sin(theta)) > 0.3)  # v_r vanishes under the axle
+    k_err = k[k_bins] / default_radial_decay_per_m(res.beta_rad[k_bins]) - 1
+    a3_err = a3[contact] / default_tangential_decay_per_m(res.beta_rad[contact]) - 1
+    assert np.all(np.abs(k_err) < 0.05), k_err
+    assert np.all(np.abs(a3_err) < 0.05), a3_err
+    assert res.sled_velocity_mps[0] == pytest.approx(scene.velocity_mps, rel=0.01)
+    assert res.mean.outlier_fraction < 0.01
+    for f in np.array(res.tangential)[contact]:
+        assert f.ci95_per_m[0] < f.rate_per_m < f.ci95_per_m[1] and f.r2 > 0.8
+    assert res.grouser is None
+
+
+def test_alpha1_alpha2_from_given_strain(smooth_wheel):
+    scene, r = smooth_wheel
+    res = analyse_frames(r.frames[:4], r.t_s[:4], scene.px_per_m)
+    k = np.array([f.rate_per_m if f else np.nan for f in res.radial])
+    alpha1, alpha2 = 2.0, 0.05
+    eps = alpha1 / k - alpha2  # the strain for which k = alpha1 / (eps + alpha2) exactly
+    res = analyse_frames(r.frames[:4], r.t_s[:4], scene.px_per_m, eps_vol_by_beta=eps)
+    assert res.alpha12["alpha1_per_m"] == pytest.approx(alpha1, rel=1e-6)
+    assert res.alpha12["alpha2"] == pytest.approx(alpha2, rel=1e-6)
+
+
+@pytest.mark.parametrize("model, seed", [("piecewise", 100), ("gear", 103)])
+def test_grouser_model_chosen(model, seed):
+    scene = FlowScene(grouser_count=12, grouser_height_px=10, grouser_model=model,
+                      grouser_gamma=3.0, seed=seed, supersample=3)
+    r = render_flow(scene, 6)
+    res = analyse_frames(r.frames, r.t_s, scene.px_per_m, wheel_radius_px=100,
+                         grouser_count=12, grouser_height_px=10)
+    assert res.grouser["chosen"] == model, res.grouser
+    assert set(res.grouser["scores_mps"]) == {"piecewise", "cosine", "cosine_series", "gear"}
+
+
+def test_cli_json(smooth_wheel, tmp_path, capsys):
+    scene, r = smooth_wheel
+    write_flow_render(r, tmp_path / "run")
+    out = tmp_path / "flow.json"
+    assert main(["flow", str(tmp_path / "run"), "--frames", "0:4", "--json", str(out),
+                 "--plots", str(tmp_path / "plots")]) == 0
+    data = json.loads(out.read_text())
+    assert data["frame_range"] == [0, 4] and data["pairs"] == 3
+    row = data["per_beta"][0]
+    assert {"beta_deg", "k", "alpha3"} <= set(row)
+    assert {"rate_per_m", "ci95_per_m", "r2", "amplitude_mps"} <= set(row["alpha3"])
+    assert len(list((tmp_path / "plots").glob("*.png"))) == 3
+    assert "alpha3_per_m" in capsys.readouterr().out
+
+
+def test_cli_bad_input(tmp_path, capsys):
+    assert main(["flow", str(tmp_path / "nothing")]) == 3
+    assert "no such file" in capsys.readouterr().err
+
+
+def test_frames_from_folder_range(smooth_wheel, tmp_path):
+    scene, r = smooth_wheel
+    write_flow_render(r, tmp_path / "run")
+    fs = load_frames(tmp_path / "run", (2, 5))
+    assert fs.frame_range == (2, 5) and len(fs.frames) == 3
+    assert fs.t_s == pytest.approx(r.t_s[2:5])
+    assert fs.px_per_m == scene.px_per_m and fs.wheel_radius_px == pytest.approx(100)
