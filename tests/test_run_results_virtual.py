@@ -17,31 +17,17 @@ import pytest
 
 import ingest
 from run_results import RigCompliance, process_run, results_table, towed_vs_powered
-from virtual_testbed import Rates, RunCondition, SensorModel, generate_campaign
+from virtual_testbed import RunCondition, SensorModel, generate_campaign
+from virtual_testbed.sample_campaign import SAMPLE_RATES
+from virtual_testbed.varied_campaign import varied_conditions
 from virtual_testbed import Testbed as VirtualTestbed
 from virtual_testbed.grousers import oscillation_shape
 
-RATES = Rates(40.0, 40.0, 20.0, 20.0, 10.0, 10.0)
+RATES = SAMPLE_RATES
 TRUTH_KEY = {"resistance_n": "motion_resistance_n"}
 LAW_KEY = {"slip": "slip", "dp_n": "dp_n", "torque_nm": "torque_nm", "thrust_n": "thrust_n",
            "resistance_n": "resistance_n", "sinkage_m": "sinkage_m"}
 FORCES = ("wheel_load_n", "dp_n", "thrust_n", "resistance_n")
-
-
-def varied_conditions(seed: int = 7) -> list[RunCondition]:
-    """Same design as tests/test_stable_phase_virtual.py: 44 speed-control runs
-    (60-320 N, slip -0.2..0.8, multipass 0-2), 4 free sled, 4 towed, 4 dig-in."""
-    rng = np.random.default_rng(seed)
-    out = [RunCondition(f"sc{i:02d}", "speed_control", float(np.round(rng.uniform(60, 320))),
-                        int(rng.integers(0, 3)), float(np.round(rng.uniform(-0.2, 0.8), 3)))
-           for i in range(44)]
-    for i, (load, mp) in enumerate([(80, 0), (180, 1), (250, 2), (320, 0)]):
-        out += [RunCondition(f"fs{i}", "free_sled", float(load), mp),
-                RunCondition(f"tw{i}", "towed", float(load), mp)]
-    out += [RunCondition(f"dig{i}", "speed_control", float(load), mp, slip)
-            for i, (load, mp, slip) in enumerate([(180, 0, 0.92), (300, 0, 0.9), (250, 1, 0.93),
-                                                   (120, 0, 0.96)])]
-    return out
 
 
 def _campaign(out, seed: int, testbed: VirtualTestbed | None = None):

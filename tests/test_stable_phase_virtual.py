@@ -13,26 +13,12 @@ import pytest
 
 import ingest
 from stable_phase import DETECTORS, StablePhaseParams, detect_stable_phase
-from virtual_testbed import Rates, RunCondition, generate_campaign
+from virtual_testbed import generate_campaign
+from virtual_testbed.sample_campaign import SAMPLE_RATES
+from virtual_testbed.varied_campaign import varied_conditions
 
-RATES = Rates(40.0, 40.0, 20.0, 20.0, 10.0, 10.0)   # the sample campaign's rates
+RATES = SAMPLE_RATES
 START_TOLERANCE_S = 2.0
-
-
-def varied_conditions(seed: int = 7) -> list[RunCondition]:
-    """44 speed-control runs (60-320 N, slip -0.2..0.8, multipass 0-2), 4 free sled,
-    4 towed and 4 dig-in runs (slip above the testbed's dig-in threshold)."""
-    rng = np.random.default_rng(seed)
-    out = [RunCondition(f"sc{i:02d}", "speed_control", float(np.round(rng.uniform(60, 320))),
-                        int(rng.integers(0, 3)), float(np.round(rng.uniform(-0.2, 0.8), 3)))
-           for i in range(44)]
-    for i, (load, mp) in enumerate([(80, 0), (180, 1), (250, 2), (320, 0)]):
-        out += [RunCondition(f"fs{i}", "free_sled", float(load), mp),
-                RunCondition(f"tw{i}", "towed", float(load), mp)]
-    out += [RunCondition(f"dig{i}", "speed_control", float(load), mp, slip)
-            for i, (load, mp, slip) in enumerate([(180, 0, 0.92), (300, 0, 0.9), (250, 1, 0.93),
-                                                   (120, 0, 0.96)])]
-    return out
 
 
 @pytest.fixture(scope="module")
