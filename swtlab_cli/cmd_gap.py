@@ -16,7 +16,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "and resistance; candidate explanations (soil recalibration, each missing "
                     "effect, pairs) fitted and scored on held-out loads, multipass and gravity "
                     "levels; a verdict (effects, none, or inconclusive with the test that "
-                    "would decide); held-out RMSE before and after. docs/gap-report.md.")
+                    "would decide); held-out RMSE before and after. docs/gap-report.md. "
+                    "With a database as the measured side, the report is also recorded there "
+                    "(and shown by swtlab report).")
     p.add_argument("--measured", required=True,
                    help="database URL (swtlab process), WPM CSV, or CMU smooth_runs.csv")
     p.add_argument("--sim", required=True, help="model TOML or a simulator's WPM CSV")
@@ -52,6 +54,12 @@ def run(args: argparse.Namespace) -> int:
     except (OSError, ValueError, KeyError) as exc:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
+    if "://" in args.measured:  # measured from a database: the report is recorded there too
+        from traceability import open_database
+        from traceability.store_gap import store_gap_report
+
+        with open_database(args.measured).begin() as session:
+            store_gap_report(session, report)
     verdict = report["verdict"]
     print("verdict:", verdict if isinstance(verdict, str) else (", ".join(verdict) or "none"))
     print("reason:", report["reason"])

@@ -5,10 +5,14 @@ from __future__ import annotations
 
 import json
 
+from sqlalchemy import select
+
 import terramechanics as tm
+import virtual_testbed as vt
 from sim_gap.bench import FAST_DESIGN, base_model, conditions, run_bench, score
 from swtlab_cli.main import main
-import virtual_testbed as vt
+from traceability import open_database
+from traceability.models import GapReport
 
 REQUIRED = {"verdict", "candidates", "held_out_rmse_before", "held_out_rmse_after",
             "shrink_pct", "regions", "reason", "separating_test", "untestable_effects"}
@@ -36,6 +40,16 @@ def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
     html = (tmp_path / "gap.html").read_text()
     assert "data:image/png;base64," in html and "slip_sinkage" in html
     assert "verdict: slip_sinkage" in capsys.readouterr().out
+    # recorded in the measured database, and shown by the campaign report
+    with open_database(db)() as session:
+        (row,) = session.scalars(select(GapReport)).all()
+        assert row.verdict == ["slip_sinkage"] and row.report["shrink_pct"] == report["shrink_pct"]
+        assert row.processing.stage == "gap"
+    page = tmp_path / "report.html"
+    assert main(["report", "--db", db, "-o", str(page), "--quiet"]) == 0
+    section = page.read_text().split('<section id="gap">', 1)[1].split("</section>", 1)[0]
+    assert "Sim-to-real gap" in section and "slip_sinkage" in section
+    assert section.count("data:image/png;base64,") >= 1
 
 
 def test_gap_cli_bad_input(tmp_path, capsys):

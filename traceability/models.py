@@ -261,3 +261,17 @@ class WpmExportFit(Base):
     __tablename__ = "wpm_export_fit"
     wpm_export_id: Mapped[int] = mapped_column(ForeignKey("wpm_export.id"), primary_key=True)
     curve_fit_id: Mapped[int] = mapped_column(ForeignKey("curve_fit.id"), primary_key=True)
+
+
+class GapReport(Base):
+    """A sim-to-real gap diagnosis of this database's results against a simulation
+    (the JSON of docs/gap-report.md, with the verdict apart for queries)."""
+
+    __tablename__ = "gap_report"
+    id: Mapped[int] = mapped_column(primary_key=True)
+    sim_source: Mapped[str] = mapped_column(String(1000))
+    verdict: Mapped[list | str] = mapped_column(JSON)
+    report: Mapped[dict] = mapped_column(JSON)
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    processing: Mapped[ProcessingRecord] = relationship()
