@@ -26,9 +26,9 @@ demo: $(STAMP)
 	$(BIN)/swtlab results --db sqlite:///$(OUT)/swtlab.sqlite --csv $(OUT)/results.csv
 	$(BIN)/swtlab export --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/wpm.csv
 	$(BIN)/swtlab wpm query $(OUT)/wpm.csv --load 120 --dp 25 --multipass 0
-	$(BIN)/swtlab report --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/report.html
 	$(BIN)/swtlab gap --measured sqlite:///$(OUT)/swtlab.sqlite \
 	    --sim terramechanics/models/bb2_sand.toml --json $(OUT)/gap.json --html $(OUT)/gap.html
+	$(BIN)/swtlab report --db sqlite:///$(OUT)/swtlab.sqlite -o $(OUT)/report.html
 	@echo "results: report $(OUT)/report.html (open it in a browser), database $(OUT)/swtlab.sqlite,"
 	@echo "         one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv,"
 	@echo "         sim-to-real gap report in $(OUT)/gap.html"
