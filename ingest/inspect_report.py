@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ingest.run import Run
+from plain_json import jsonable
 
 _DERIVED_UNITS = {"slip": "1"}
 
@@ -34,25 +35,12 @@ def report(run: Run) -> dict:
         columns.append({"column": column, "unit": _column_unit(column),
                         "valid_fraction": float(finite.mean()) if len(values) else 0.0,
                         "mean": float(values[finite].mean()) if finite.any() else None})
-    return _plain({"source": str(run.source), "channel_map": run.channel_map,
+    return jsonable({"source": str(run.source), "channel_map": run.channel_map,
                    "metadata": run.metadata.to_dict(), "streams": streams,
                    "time_base": run.derivation.get("time_base"), "channels": columns,
                    "frames": [f.to_dict() for f in run.frames.values()],
                    "derivation": run.derivation,
                    "problems": [p.to_dict() for p in run.problems]})
-
-
-def _plain(value):
-    """JSON-ready: numpy scalars to Python, NaN/inf to None, tuples to lists."""
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value
 
 
 def _fmt(value) -> str:

@@ -2,24 +2,13 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 from run_results.stats import QuantityStats
 from stable_phase import StableWindow
+from plain_json import jsonable
 
 STATUSES = ("ok", "flagged", "no_stable_phase")
-
-
-def _json_number(value):
-    """NaN/inf become None so the dict is strict JSON."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _json_number(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_number(v) for v in value]
-    return value
 
 
 @dataclass(frozen=True)
@@ -44,7 +33,7 @@ class RunResult:
 
     def to_dict(self) -> dict:
         """JSON-ready dict (NaN as null)."""
-        return _json_number({
+        return jsonable({
             "run_id": self.run_id, "mode": self.mode, "status": self.status,
             "flags": list(self.flags), "window": self.window.to_dict(),
             "quantities": {k: v.to_dict() for k, v in self.quantities.items()},

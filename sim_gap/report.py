@@ -6,25 +6,13 @@ from __future__ import annotations
 import base64
 import html
 import json
-import math
 from pathlib import Path
+
+from plain_json import jsonable
 
 SCHEMA = "swtlab.gap-report/1"
 REGION_HEAD = ["slip band", "load N", "multipass", "gravity", "quantity", "mean residual",
                "per load", "z"]
-
-
-def _clean(value):
-    """JSON-safe: non-finite floats become null, numpy scalars plain numbers."""
-    if isinstance(value, dict):
-        return {str(k): _clean(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_clean(v) for v in value]
-    if hasattr(value, "item") and not isinstance(value, (str, bytes)):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def build_report(diagnosis: dict, measured_source: str, sim_source: str,
@@ -55,7 +43,7 @@ def build_report(diagnosis: dict, measured_source: str, sim_source: str,
         "sinkage_relative": diagnosis["sinkage_relative"],
         "settings": settings or {},
     }
-    return _clean(out)
+    return jsonable(out)
 
 
 def write_json(report: dict, path: str | Path) -> None:

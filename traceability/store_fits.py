@@ -12,9 +12,9 @@ import pandas as pd
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
+from plain_json import jsonable
 from traceability.models import CurveFit, RunResult, WpmExport
 from traceability.store import new_processing_record
-from traceability.store_results import jsonable
 
 GROUP_COLUMNS = ("wheel", "soil", "multipass", "load_n")
 ROW_ID = "result_id"

@@ -11,6 +11,7 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
+from plain_json import jsonable
 from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
 from traceability.store import new_processing_record
 
@@ -72,16 +73,3 @@ def _num(value: Any) -> float | None:
         return None
     value = float(value)
     return value if value == value and abs(value) != float("inf") else None
-
-
-def jsonable(value: Any) -> Any:
-    """JSON-ready copy: numpy scalars to Python numbers, NaN/inf to None, tuples to lists."""
-    if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(v) for v in value]
-    if hasattr(value, "tolist"):
-        return jsonable(value.tolist())
-    if isinstance(value, float):
-        return _num(value)
-    return value
