@@ -41,7 +41,7 @@ class FlowResult:
     profiles_t: list = field(default_factory=list)
     grouser: dict | None = None
     alpha12: dict | None = None
-    engine: str = "farneback"
+    engine: str = "deform-lk"
     source: str = ""
 
     def to_dict(self) -> dict:
@@ -80,7 +80,7 @@ def _rates(fits: list[DecayFit | None]) -> np.ndarray:
 def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
                    direction: int = 1, wheel_center_px: tuple[float, float] | None = None,
                    wheel_radius_px: float | None = None, grouser_count: int | None = None,
-                   grouser_height_px: float | None = None, engine: str = "farneback",
+                   grouser_height_px: float | None = None, engine: str = "deform-lk",
                    eps_vol_by_beta: np.ndarray | None = None,
                    frame_range: tuple[int, int] | None = None, source: str = "") -> FlowResult:
     """Run the whole SOFT analysis on grey frames of the stable phase (2 or more)."""

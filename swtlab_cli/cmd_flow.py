@@ -9,6 +9,8 @@ from pathlib import Path
 
 from swtlab_cli import exit_codes
 
+ENGINE_CHOICES = ("deform-lk", "farneback", "dis")  # softflow.flow_engine.ENGINES, kept light
+
 
 def _frames(text: str) -> tuple[int | None, int | None]:
     try:
@@ -34,8 +36,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--plots", metavar="DIR", help="write the PNG plots into DIR")
     p.add_argument("--px-per-m", type=float, help="scale, when swt.camera does not give it")
     p.add_argument("--fps", type=float, help="frame rate, when the frames carry no times")
-    p.add_argument("--engine", choices=("farneback", "dis"), default="farneback",
-                   help="optical-flow engine (default farneback, see docs/softflow.md)")
+    p.add_argument("--engine", choices=ENGINE_CHOICES, default=ENGINE_CHOICES[0],
+                   help="optical-flow engine (default deform-lk, see docs/softflow.md)")
     p.set_defaults(func=run)
 
 
