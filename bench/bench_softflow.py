@@ -2,8 +2,9 @@
 
 1. 1-megapixel renders of :mod:`virtual_testbed.flow_render` (grousered wheel,
    noise, flicker, smudges): displacement RMS error, bias, share of vectors off by
-   more than 0.5 px and frame pairs per second, side by side for swtlab (Farneback
-   + window deformation), plain OpenCV Farneback, OpenPIV multi-pass window
+   more than 0.5 px and frame pairs per second, side by side for swtlab (``deform-lk``,
+   with the machine's threads and with one thread), plain OpenCV Farneback, OpenPIV
+   multi-pass window
    deformation 64/32/16 (``windef``) and OpenPIV single pass 32 px
    (``pyprocess.extended_search_area_piv``). All are scored at OpenPIV's final grid
    points whose 16 px window lies on soil; swtlab and Farneback also densely.
@@ -24,6 +25,7 @@ import time
 from pathlib import Path
 
 import cv2
+import numba
 import numpy as np
 from scipy import ndimage
 
@@ -80,6 +82,20 @@ def _farneback_plain(a, b):
                                         cv2.OPTFLOW_FARNEBACK_GAUSSIAN)
 
 
+def _single_thread(fn):
+    """``fn`` run with OpenCV and numba on one thread (OpenPIV's numpy FFTs use one)."""
+    def run(a, b):
+        cv_threads, nb_threads = cv2.getNumThreads(), numba.get_num_threads()
+        cv2.setNumThreads(1)
+        numba.set_num_threads(1)
+        try:
+            return fn(a, b)
+        finally:
+            cv2.setNumThreads(cv_threads)
+            numba.set_num_threads(nb_threads)
+    return run
+
+
 def renders_1mp(pairs: int) -> dict:
     scene = FlowScene(size_px=(1024, 1024), px_per_m=2000, fps=50, wheel_center_px=(512, 300),
                       wheel_radius_px=200, grouser_count=16, grouser_height_px=16,
@@ -87,7 +103,10 @@ def renders_1mp(pairs: int) -> dict:
     r = render_flow(scene, pairs + 1)
     piv = _openpiv()
     signs = {name: _sign_of_v(fn) for name, fn in piv.items()}
-    dense = {"swtlab": pair_displacement_px, "opencv_farneback": _farneback_plain}
+    dense = {"swtlab": pair_displacement_px,
+             "swtlab_1_thread": _single_thread(pair_displacement_px),
+             "opencv_farneback": _farneback_plain}
+    pair_displacement_px(r.frames[0][:64, :64], r.frames[1][:64, :64])  # numba: load compiled
     out = {name: {"errors": [], "dense_errors": [], "seconds": 0.0, "failures": 0}
            for name in list(dense) + list(piv)}
     for k in range(pairs):
@@ -126,7 +145,9 @@ def renders_1mp(pairs: int) -> dict:
         if o["dense_errors"]:
             row["dense"] = _scores(np.concatenate(o["dense_errors"]))
         table[name] = row
-    return {"frame_px": [1024, 1024], "pairs": pairs, "openpiv_v_sign": signs, "methods": table}
+    return {"frame_px": [1024, 1024], "pairs": pairs, "openpiv_v_sign": signs,
+            "threads": {"opencv": cv2.getNumThreads(), "numba": numba.get_num_threads()},
+            "methods": table}
 
 
 def openpiv_bundled() -> dict:

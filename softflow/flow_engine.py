@@ -58,6 +58,7 @@ ENGINES = ("deform-lk", "farneback", "dis")
 GRID_PX = 2  # the windows are solved on a grid this much coarser than the pixels
 FIXED_KERNEL_PX = 11  # stack-blur size (grid points) of the fixed-window pass
 ICI_KERNELS_PX = (5, 7, 11, 15, 21, 29)  # stack-blur sizes (grid points) of the adaptive pass
+FIXED_PASS_INTERPOLATION = cv2.INTER_LINEAR  # the last pass corrects its bias
 RATE_KERNELS_PX = (3,)  # one small fixed window for the decay-rate analysis (average_flow)
 ICI_GAMMA = 2.0
 NORMALISE_KERNEL_PX = 11  # box
@@ -170,10 +171,10 @@ class _Deformer:
         self.p1 = np.empty((h, w), np.float32)
         self.diff = np.empty((h, w), np.float32)
 
-    def products(self, flow: np.ndarray) -> None:
+    def products(self, flow: np.ndarray, interpolation: int = cv2.INTER_LANCZOS4) -> None:
         """Fill ``p4``, ``p1`` and ``diff`` for the warp by ``flow``."""
         _quantised_maps(flow, self.ux, self.uy, self.map_x, self.map_y)
-        warped = cv2.remap(self.b, self.map_x, self.map_y, cv2.INTER_LANCZOS4,
+        warped = cv2.remap(self.b, self.map_x, self.map_y, interpolation,
                            borderMode=cv2.BORDER_REFLECT)
         _products(self.a, warped, self.soil, self.ux, self.uy, self.p4, self.p1, self.diff)
 
@@ -200,7 +201,7 @@ def _deform_lk(a: np.ndarray, b: np.ndarray, soil: np.ndarray, flow: np.ndarray,
                windows: tuple[int, ...]) -> np.ndarray:
     """A fixed-window pass, then one over ``windows`` (ICI when several): module docstring."""
     deformer = _Deformer(a, b, soil)
-    deformer.products(flow)
+    deformer.products(flow, FIXED_PASS_INTERPOLATION)
     p4, p1 = deformer.coarse_products()
     hc, wc = p1.shape
     coarse = cv2.resize(flow, (wc, hc), interpolation=cv2.INTER_AREA)
