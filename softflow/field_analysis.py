@@ -4,9 +4,10 @@ Pipeline (issue items 2-5): track the wheel (:mod:`softflow.wheel_detect`), mask
 measure and average the soil flow (:mod:`softflow.flow_engine`), go to the world
 frame and resolve about the axle (:mod:`softflow.polar`), fit ``k(beta)`` and
 ``alpha3(beta)`` (:mod:`softflow.decay_fit`), and for a grousered wheel score the
-effective-radius models (:mod:`softflow.grouser_models`). Where ``eps_vol^P(beta)``
-is given, ``1/k = eps/alpha1 + alpha2/alpha1`` is regressed over beta (alpha1,
-alpha2 constant) to separate ``alpha1`` and ``alpha2``.
+effective-radius models (:mod:`softflow.grouser_models`). ``eps_vol^P(beta)`` is
+given or estimated from the measured field (:mod:`softflow.volumetric_strain`), and
+``1/k = eps/alpha1 + alpha2/alpha1`` is regressed over beta (alpha1, alpha2
+constant; :mod:`softflow.alpha12`) to separate ``alpha1`` and ``alpha2``.
 """
 
 from __future__ import annotations
@@ -15,10 +16,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from softflow.alpha12 import fit_alpha12, rates_and_sigmas
 from softflow.decay_fit import DecayFit, fit_decay
 from softflow.flow_engine import MeanField, average_flow
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
+from softflow.volumetric_strain import strain_by_beta
 from softflow.wheel_detect import WheelPose, soil_mask, track_wheel
 
 BIN_WIDTH_DEG = 10.0
@@ -43,9 +46,13 @@ class FlowResult:
     alpha12: dict | None = None
     engine: str = "deform-lk"
     source: str = ""
+    eps_vol_p: np.ndarray | None = None  # per beta bin, compression positive
+    eps_source: str | None = None  # "given" or "estimated"
+    eps_depth_m: float | None = None  # estimated: taken this far outside the wheel
 
     def to_dict(self) -> dict:
         p0 = self.poses[0]
+        eps = np.full(len(self.beta_rad), np.nan) if self.eps_vol_p is None else self.eps_vol_p
         return {
             "schema": "swtlab.softflow/1",
             "source": self.source,
@@ -66,9 +73,12 @@ class FlowResult:
             "per_beta": [
                 {"beta_deg": float(np.rad2deg(b)),
                  "k": r.to_dict() if r else None,
-                 "alpha3": t.to_dict() if t else None}
-                for b, r, t in zip(self.beta_rad, self.radial, self.tangential)],
+                 "alpha3": t.to_dict() if t else None,
+                 "eps_vol_p": None if np.isnan(e) else float(e)}
+                for b, r, t, e in zip(self.beta_rad, self.radial, self.tangential, eps)],
             "alpha1_alpha2": self.alpha12,
+            "eps_vol_p_source": self.eps_source,
+            "eps_vol_p_depth_m": self.eps_depth_m,
             "grouser_model": self.grouser,
         }
 
@@ -82,8 +92,13 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
                    wheel_radius_px: float | None = None, grouser_count: int | None = None,
                    grouser_height_px: float | None = None, engine: str = "deform-lk",
                    eps_vol_by_beta: np.ndarray | None = None,
-                   frame_range: tuple[int, int] | None = None, source: str = "") -> FlowResult:
-    """Run the whole SOFT analysis on grey frames of the stable phase (2 or more)."""
+                   frame_range: tuple[int, int] | None = None, source: str = "",
+                   eps_depth_m: float | None = None) -> FlowResult:
+    """Run the whole SOFT analysis on grey frames of the stable phase (2 or more).
+
+    Without ``eps_vol_by_beta`` (per beta bin), ``eps_vol^P`` is estimated below the
+    axle at ``eps_depth_m`` (default a fifth of the rim radius) outside the wheel.
+    """
     if len(frames) < 2:
         raise ValueError("need at least two frames")
     poses = track_wheel(frames, direction, wheel_center_px, wheel_radius_px, grouser_count,
@@ -110,12 +125,18 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
                         (float(sled[0]), float(sled[1])), centres, radial, tangential,
                         prof_r, prof_t, engine=engine, source=source)
     if eps_vol_by_beta is not None:
-        k = _rates(radial)
-        ok = np.isfinite(k) & np.isfinite(eps_vol_by_beta)
-        if ok.sum() >= 3:
-            slope, intercept = np.polyfit(eps_vol_by_beta[ok], 1 / k[ok], 1)
-            result.alpha12 = {"alpha1_per_m": float(1 / slope),
-                              "alpha2": float(intercept / slope), "bins_used": int(ok.sum())}
+        result.eps_vol_p, result.eps_source = np.asarray(eps_vol_by_beta, float), "given"
+    else:
+        depth_m = rim / px_per_m / 5 if eps_depth_m is None else eps_depth_m
+        below = centres < 0  # a bin has soil below the axle only
+        result.eps_vol_p = np.full(len(centres), np.nan)
+        result.eps_vol_p[below] = strain_by_beta(
+            mean.velocity_px_per_s, center, rim + poses[0].grouser_height_px + depth_m * px_per_m,
+            centres[below], width, -np.asarray(sled) * px_per_m)
+        result.eps_source, result.eps_depth_m = "estimated", depth_m
+    result.alpha12 = fit_alpha12(result.eps_vol_p, *rates_and_sigmas(radial))
+    if result.alpha12:
+        result.alpha12["eps_source"] = result.eps_source
     if poses[0].grouser_count and poses[0].grouser_height_px > 0:
         result.grouser = _grouser_selection(result, frames[0].shape, direction, r_min)
     return result

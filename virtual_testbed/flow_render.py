@@ -24,12 +24,22 @@ truth displacement of pair ``(k, k+1)`` at pixel ``x`` of frame ``k`` is exactly
 ``u_k(x) dt``. Then: the wheel (rim disc with a rotating pattern, grousers) drawn
 over with anti-aliased edges, glass-wall smudges (moving with the bin, i.e. at
 ``-V``), illumination flicker, camera noise. Never imports an estimator.
+
+Self-consistent ``k`` (off by default; ``FlowScene.alpha1_per_m`` and ``alpha2``):
+``k(beta) = alpha1 / (eps(beta) + alpha2)`` with ``eps(beta)`` the volumetric strain
+(compression positive, logarithmic) that this very field gives to the soil at
+``eps_depth_px`` outside the rim: ``d eps / ds = -(div u) / |u|`` integrated (RK4,
+closed-form divergence) along the streamline of the steady camera-frame field from
+far upstream (``exp(-20)`` of the disturbance left) to the point. ``k`` and ``eps``
+depend on each other: solved by Anderson-accelerated fixed-point iteration to 1e-6.
+Smooth-wheel, steady scenes only; ``truth`` then holds ``eps_vol_p`` (on
+``BETA_GRID``, below the axle), ``alpha1_per_m``, ``alpha2``, ``eps_depth_px``.
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import cv2
@@ -97,6 +107,9 @@ class FlowScene:
     flicker: float = 0.02  # relative standard deviation of the illumination, frame to frame
     smudges: int = 6  # blurry glass-wall smudges
     seed: int = 0
+    alpha1_per_m: float | None = None  # set both: k(beta) = alpha1 / (eps(beta) + alpha2)
+    alpha2: float | None = None
+    eps_depth_px: float | None = None  # where eps(beta) is taken, outside the rim; None: R / 5
 
     @property
     def omega_radps(self) -> float:
@@ -151,6 +164,120 @@ def _soil_velocity_px_per_frame(x: np.ndarray, y: np.ndarray, scene: FlowScene, 
     u_down = v_r * c - v_t * s - vz
     scale = scene.px_per_m / scene.fps
     return d * u_travel * scale, u_down * scale
+
+
+def _soil_divergence_per_frame(x: np.ndarray, y: np.ndarray, scene: FlowScene,
+                               center: tuple[float, float]) -> np.ndarray:
+    """Closed-form ``div u`` (1/frame) of the smooth-wheel model field (0 inside the rim,
+    where the field is the rim's: ``u = -R omega e_th``).
+
+    ``div = (1/r) d(r v_r)/dr + (1/r) d(v_th)/d(th)`` with ``v_r = A exp(-k rho)``,
+    ``v_th = B exp(-alpha3 rho)``, ``A = V . e_r``, ``B = V . e_th - R omega``, ``dB/dth = -A``.
+    """
+    d = scene.travel_direction
+    dx, dy = x - center[0], y - center[1]
+    r = np.hypot(dx, dy)
+    beta = np.arctan2(-dy, dx)
+    theta = np.arctan2(d * dx, dy)
+    rho = np.maximum(r - scene.wheel_radius_px, 0.0)
+    k = _decay(scene.radial_decay_per_m, default_radial_decay_per_m, beta) / scene.px_per_m
+    a3 = _decay(scene.tangential_decay_per_m, default_tangential_decay_per_m, beta) / scene.px_per_m
+    h = 1e-6  # d alpha3 / d theta = direction * d alpha3 / d beta, central difference
+    da3 = d * (_decay(scene.tangential_decay_per_m, default_tangential_decay_per_m, beta + h)
+               - _decay(scene.tangential_decay_per_m, default_tangential_decay_per_m, beta - h)
+               ) / (2 * h * scene.px_per_m)
+    scale = scene.px_per_m / scene.fps
+    vx, vz = scene.velocity_mps * scale, scene.sink_velocity_mps * scale
+    rim_speed = scene.wheel_radius_px / scene.px_per_m * scene.omega_radps * scale
+    s, c = np.sin(theta), np.cos(theta)
+    a, b = vx * s + vz * c, vx * c - vz * s - rim_speed
+    div = a * np.exp(-k * rho) * (1 / r - k) - (a + b * rho * da3) * np.exp(-a3 * rho) / r
+    return np.where(r > scene.wheel_radius_px, div, 0.0)
+
+
+def volumetric_strain_truth(scene: FlowScene, depth_px: float, beta: np.ndarray,
+                            step_px: float = 1.0) -> np.ndarray:
+    """``eps`` at ``depth_px`` outside the rim at image angles ``beta`` (steady field, t = 0).
+
+    RK4 upstream along ``-u/|u|`` of ``(x, y, eps)`` with ``d eps/ds = -div u / |u|``,
+    steps of ``step_px`` growing as ``rho / 20`` away from the rim (the field varies on
+    the scale ``rho`` there; quartering either changes eps by < 1e-4), until the
+    disturbance has decayed to ``exp(-20)`` (``rho > 20 / min(k, alpha3)``).
+    """
+    c = scene.wheel_center_px
+    grid = BETA_GRID[:-1]
+    rates = np.concatenate([_decay(scene.radial_decay_per_m, default_radial_decay_per_m, grid),
+                            _decay(scene.tangential_decay_per_m, default_tangential_decay_per_m,
+                                   grid)])
+    rho_far = 20 / rates.min() * scene.px_per_m
+    r0 = scene.wheel_radius_px + depth_px
+    state = np.stack([c[0] + r0 * np.cos(beta), c[1] - r0 * np.sin(beta), np.zeros_like(beta)])
+
+    def slope(p):
+        ux, uy = _soil_velocity_px_per_frame(p[0], p[1], scene, 0.0, c)
+        speed = np.hypot(ux, uy)
+        return np.stack([-ux, -uy, -_soil_divergence_per_frame(p[0], p[1], scene, c)]) / speed
+
+    eps = np.full(len(beta), np.nan)
+    active = np.arange(len(beta))
+    rho = np.full(len(beta), float(depth_px))
+    for _ in range(int(20 * (r0 + rho_far) / step_px)):
+        p = state[:, active]
+        h = np.maximum(step_px, rho[active] / 20)
+        k1 = slope(p)
+        k2 = slope(p + h / 2 * k1)
+        k3 = slope(p + h / 2 * k2)
+        k4 = slope(p + h * k3)
+        p = p + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        state[:, active] = p
+        rho[active] = np.hypot(p[0] - c[0], p[1] - c[1]) - scene.wheel_radius_px
+        far = rho[active] > rho_far
+        eps[active[far]] = p[2][far]
+        active = active[~far]
+        if not len(active):
+            break
+    return eps
+
+
+def _self_consistent_scene(scene: FlowScene) -> tuple[FlowScene, dict]:
+    """The scene with ``k = alpha1 / (eps + alpha2)`` tabulated, and the strain truth.
+
+    ``eps`` is traced below the axle (``beta <= 0``, where a bin has soil); above it
+    (soil only in this scene) ``eps`` is interpolated linearly across ``beta``.
+    """
+    if scene.alpha2 is None or scene.radial_decay_per_m or scene.grouser_model \
+            or scene.sink_px_per_frame:
+        raise ValueError("alpha1_per_m needs alpha2, no radial_decay_per_m table, no grouser "
+                         "soil model and no sink_px_per_frame (a steady smooth-wheel field)")
+    depth = scene.wheel_radius_px / 5 if scene.eps_depth_px is None else scene.eps_depth_px
+    a1, a2 = scene.alpha1_per_m, scene.alpha2
+    below = BETA_GRID <= 0
+    k = default_radial_decay_per_m(BETA_GRID)
+    tried, images = [], []  # Anderson acceleration, depth 3 (Walker & Ni 2011, SIAM JNA 49)
+    for _ in range(60):
+        eps = volumetric_strain_truth(replace(scene, radial_decay_per_m=tuple(k)), depth,
+                                      BETA_GRID[below])
+        filled = np.interp(BETA_GRID, BETA_GRID[below], eps, period=2 * np.pi)
+        if not np.all(filled + a2 > 0):  # also False where a streamline never got far
+            raise ValueError(f"eps + alpha2 must be > 0 (eps from {np.nanmin(eps):.3f}): "
+                             "choose a larger alpha2")
+        g = a1 / (filled + a2)
+        residual = float(np.max(np.abs(g - k) / k))
+        if residual < 1e-6:
+            break
+        tried, images = (tried + [k])[-4:], (images + [g])[-4:]
+        f = np.array(images) - np.array(tried)
+        gamma = np.linalg.lstsq(np.diff(f, axis=0).T, f[-1], rcond=None)[0]
+        k = g - np.diff(images, axis=0).T @ gamma
+        if np.any(k <= 0):
+            k = g
+    truth = {"alpha1_per_m": a1, "alpha2": a2, "eps_depth_px": depth,
+             "eps_vol_p": [float(e) if b else None for e, b in zip(filled, below)],
+             "eps_vol_p_definition": "logarithmic volumetric strain, compression positive, "
+                                     "accumulated along the camera-frame streamline from far "
+                                     "upstream to eps_depth_px outside the rim, beta <= 0",
+             "eps_fixed_point_residual": residual}
+    return replace(scene, radial_decay_per_m=tuple(k)), truth
 
 
 def _texture(scene: FlowScene, rng: np.random.Generator, margin_px: int) -> np.ndarray:
@@ -223,6 +350,9 @@ def _wheel_layer(scene: FlowScene, xs: np.ndarray, ys: np.ndarray, center: tuple
 
 def render_flow(scene: FlowScene, n_frames: int = 4) -> FlowRender:
     """Render ``n_frames`` consecutive frames and the exact truth of each of their pairs."""
+    strain_truth = {}
+    if scene.alpha1_per_m is not None:
+        scene, strain_truth = _self_consistent_scene(scene)
     rng = np.random.default_rng(scene.seed)
     w, h = scene.size_px
     s = scene.supersample
@@ -279,7 +409,7 @@ def render_flow(scene: FlowScene, n_frames: int = 4) -> FlowRender:
         masks.append((covers[k] == 0) & (covers[k + 1] == 0))
     render = FlowRender(scene, frames, t_s, np.array(disp), np.array(masks), centers,
                         wheel_angle)
-    render.truth = _truth_dict(scene, render)
+    render.truth = _truth_dict(scene, render) | strain_truth
     return render
 
 
