@@ -78,3 +78,10 @@ def test_average_in_velocity_units(render):
     assert np.sqrt(np.mean(err ** 2)) < 0.04
     assert mean.outlier_fraction < 0.02  # small-window field: ~1.3 % flagged at eps 0.1 px
     assert np.isnan(mean.velocity_px_per_s[100, 160]).all()  # inside the wheel
+
+
+def test_cli_engine_choices_match_the_engines():
+    """``swtlab flow --engine`` lists its choices without importing the engine (fast start)."""
+    from softflow.flow_engine import ENGINES
+    from swtlab_cli.cmd_flow import ENGINE_CHOICES
+    assert ENGINE_CHOICES == ENGINES
