@@ -7,7 +7,7 @@ points, the load-interpolation check, the exported WPM curves, and the sections 
 in :mod:`campaign_report.extensions` that have data. See docs/report.md.
 """
 
-from campaign_report import gap, image_slip  # noqa: F401 - register their optional sections
+from campaign_report import flow, gap, image_slip  # noqa: F401 - register their sections
 from campaign_report.render import page_paths, write_report, write_reports
 
 __all__ = ["page_paths", "write_report", "write_reports"]

@@ -19,8 +19,8 @@ the page code::
 :class:`~campaign_report.style.Palette` (use it so loads and multipasses look as in every
 other figure) and returns a :class:`~campaign_report.html.Section`, or None when its data
 does not exist for this campaign. Sections appear after the built-in ones, in registration
-order. Registered: image slip (:mod:`campaign_report.image_slip`), the sim-to-real gap
-(:mod:`campaign_report.gap`).
+order. Registered: the soil flow under the wheel (:mod:`campaign_report.flow`), image slip
+(:mod:`campaign_report.image_slip`), the sim-to-real gap (:mod:`campaign_report.gap`).
 """
 
 from __future__ import annotations

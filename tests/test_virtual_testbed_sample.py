@@ -70,6 +70,21 @@ def _check_track_photos(channel, messages, metadata, truth):
     assert float(metadata["swt.camera_track"]["px_per_m"]) == truth["px_per_m"]
 
 
+def _check_side_frames(images: list[tuple[int, bytes, str]], camera: dict, truth: dict):
+    """Spec: ``/camera/side`` PNG frames timed inside the stable phase, ``swt.camera`` scale and
+    travel direction; the frames are the render whose truth the truth file holds."""
+    side = truth["side_camera"]
+    assert [t for t, _, _ in images] == side["t_ns"]
+    window = truth["stable_window"]
+    assert window["start_s"] < side["t_ns"][0] / 1e9 < side["t_ns"][-1] / 1e9 < window["end_s"]
+    for _, data, fmt in images:
+        assert fmt == "png"
+        image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+        assert image is not None and image.shape == tuple(side["scene"]["size_px"][::-1])
+    assert float(camera["px_per_m"]) == side["scene"]["px_per_m"]
+    assert camera["travel_direction"] == "+x"
+
+
 def _columns(blocks: list[dict]) -> dict[str, np.ndarray]:
     return {k: np.concatenate([np.asarray(b[k]) for b in blocks]) for k in blocks[0]}
 
@@ -120,14 +135,16 @@ def test_sample_contents_and_size():
     forms = {t["form"] for t in TRUTHS.values()}
     assert forms == {"mcap", "csv"}
     total_bytes = sum(f.stat().st_size for f in SAMPLE.rglob("*") if f.is_file())
-    assert total_bytes < 6_000_000  # "a few MB at most"
+    assert total_bytes < 7_000_000  # "a few MB at most" (1.2 MB of it side-camera frames)
     photographed = [r for r, t in TRUTHS.items() if t.get("track_photos")]
     assert sorted(photographed) == ["L180_MP0_SC_s+010", "L180_MP0_SC_s+035",
                                     "L180_MP0_SC_s+060"]
+    filmed = {r: t["form"] for r, t in TRUTHS.items() if t.get("side_camera")}
+    assert filmed == {"L180_MP0_SC_s+035": "mcap", "L180_MP0_FS": "csv"}
 
 
 @pytest.mark.parametrize("run_id", ["L180_MP0_SC_s+020", "L300_MP0_SC_s+090", "L070_MP0_TW",
-                                    "L180_MP0_FS"])
+                                    "L180_MP0_FS", "L180_MP0_SC_s+035"])
 def test_regenerates_bit_for_bit(tmp_path, run_id):
     index, (condition, form) = next((i, cf) for i, cf in enumerate(sample_conditions())
                                     if cf[0].run_id == run_id)
@@ -142,10 +159,20 @@ def test_regenerates_bit_for_bit(tmp_path, run_id):
 def test_mcap_runs_follow_the_spec(run_id):
     blocks, channels, metadata = _read_mcap(SAMPLE / TRUTHS[run_id]["raw_file"])
     photos = TRUTHS[run_id].get("track_photos")
-    assert set(channels) == set(TOPICS) | ({"/camera/track"} if photos else set())
+    filmed = "side_camera" in TRUTHS[run_id]
+    assert set(channels) == (set(TOPICS) | ({"/camera/track"} if photos else set())
+                             | ({"/camera/side"} if filmed else set()))
     if photos:
         _check_track_photos(channels.pop("/camera/track"), blocks.pop("/camera/track"),
                             metadata, photos)
+    if filmed:
+        schema_encoding, schema, message_encoding = channels.pop("/camera/side")
+        assert (schema_encoding, message_encoding) == ("jsonschema", "json")
+        assert set(schema["required"]) == {"timestamp", "frame_id", "format", "data"}
+        _check_side_frames([(m["timestamp"]["sec"] * 1_000_000_000 + m["timestamp"]["nsec"],
+                             base64.b64decode(m["data"]), m["format"])
+                            for m in blocks.pop("/camera/side")],
+                           metadata["swt.camera"], TRUTHS[run_id])
     for topic, (schema_encoding, schema, message_encoding) in channels.items():
         assert (schema_encoding, message_encoding) == ("jsonschema", "json")
         assert set(schema["required"]) == {"t_ns", *TOPICS[topic]}
@@ -181,7 +208,14 @@ def test_mcap_runs_follow_the_spec(run_id):
 def test_csv_runs_follow_the_spec(run_id):
     meta, channels = _read_csv_run(SAMPLE / TRUTHS[run_id]["raw_file"])
     mode = TRUTHS[run_id]["condition"]["mode"]
-    assert set(meta) <= {"run", "wheel", "suspension", "zero", "calibration"}
+    filmed = "side_camera" in TRUTHS[run_id]
+    assert set(meta) <= {"run", "wheel", "suspension", "zero", "calibration"} | (
+        {"camera"} if filmed else set())
+    if filmed:
+        frames = sorted((SAMPLE / TRUTHS[run_id]["raw_file"] / "camera_side").iterdir(),
+                        key=lambda f: int(f.stem))
+        _check_side_frames([(int(f.stem), f.read_bytes(), f.suffix[1:]) for f in frames],
+                           meta["camera"], TRUTHS[run_id])
     assert set(meta["run"]) == RUN_KEYS and meta["run"]["mode"] == mode
     assert isinstance(meta["run"]["load_N"], float)
     assert isinstance(meta["wheel"]["grouser_count"], int)

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from datetime import datetime
 
-from sqlalchemy import JSON, DateTime, Float, ForeignKey, Integer, String, UniqueConstraint
+from sqlalchemy import (JSON, DateTime, Float, ForeignKey, Integer, LargeBinary, String,
+                        UniqueConstraint)
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
 
 
@@ -274,4 +275,85 @@ class GapReport(Base):
     report: Mapped[dict] = mapped_column(JSON)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
 
+    processing: Mapped[ProcessingRecord] = relationship()
+
+
+class SoilFlow(Base):
+    """Soil velocity field under the wheel from one raw-file version's side-camera frames in its
+    stable window (``softflow``, docs/softflow.md), once per processing parameters.
+
+    Frames ``frame_first..frame_last`` (inclusive, in time order) at ``t_first_s..t_last_s``;
+    velocities in the bin frame; the wheel as seen in the first frame (pixels). ``result`` is
+    ``FlowResult.to_dict()`` (schema ``swtlab.softflow/1``); ``field_npz`` the compact arrays the
+    report draws from (``softflow.flow_archive``).
+    """
+
+    __tablename__ = "soil_flow"
+    __table_args__ = (UniqueConstraint("raw_file_id", "params_sha256"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    raw_file_id: Mapped[int] = mapped_column(ForeignKey("raw_file.id"))
+    stable_window_id: Mapped[int] = mapped_column(ForeignKey("stable_window.id"))
+    params_sha256: Mapped[str] = mapped_column(String(64))
+    frame_first: Mapped[int] = mapped_column(Integer)
+    frame_last: Mapped[int] = mapped_column(Integer)
+    t_first_s: Mapped[float] = mapped_column(Float)
+    t_last_s: Mapped[float] = mapped_column(Float)
+    pairs: Mapped[int] = mapped_column(Integer)
+    engine: Mapped[str] = mapped_column(String(40))
+    px_per_m: Mapped[float] = mapped_column(Float)
+    sled_velocity_x_mps: Mapped[float] = mapped_column(Float)  # image x (right)
+    sled_velocity_y_mps: Mapped[float] = mapped_column(Float)  # image y (down)
+    outlier_fraction: Mapped[float] = mapped_column(Float)
+    wheel_center_x_px: Mapped[float] = mapped_column(Float)
+    wheel_center_y_px: Mapped[float] = mapped_column(Float)
+    wheel_radius_px: Mapped[float] = mapped_column(Float)
+    grouser_model: Mapped[str | None] = mapped_column(String(40), nullable=True)
+    grouser_margin_percent: Mapped[float | None] = mapped_column(Float, nullable=True)
+    grouser_gamma: Mapped[float | None] = mapped_column(Float, nullable=True)
+    alpha1_per_m: Mapped[float | None] = mapped_column(Float, nullable=True)
+    alpha2: Mapped[float | None] = mapped_column(Float, nullable=True)
+    result: Mapped[dict] = mapped_column(JSON)
+    field_npz: Mapped[bytes] = mapped_column(LargeBinary)
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    raw_file: Mapped[RawFile] = relationship()
+    window: Mapped[StableWindow] = relationship()
+    processing: Mapped[ProcessingRecord] = relationship()
+    fits: Mapped[list[SoilFlowFit]] = relationship(back_populates="flow",
+                                                   order_by="SoilFlowFit.id")
+
+
+class SoilFlowFit(Base):
+    """One decay fit ``A exp(-rate (r - R))`` of a soil flow at one angle ``beta``: component
+    ``k`` (radial) or ``alpha3`` (tangential), with its 95 % confidence interval."""
+
+    __tablename__ = "soil_flow_fit"
+    __table_args__ = (UniqueConstraint("soil_flow_id", "beta_deg", "component"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    soil_flow_id: Mapped[int] = mapped_column(ForeignKey("soil_flow.id"))
+    beta_deg: Mapped[float] = mapped_column(Float)
+    component: Mapped[str] = mapped_column(String(10))
+    amplitude_mps: Mapped[float] = mapped_column(Float)
+    rate_per_m: Mapped[float] = mapped_column(Float)
+    ci95_low_per_m: Mapped[float | None] = mapped_column(Float, nullable=True)
+    ci95_high_per_m: Mapped[float | None] = mapped_column(Float, nullable=True)
+    r2: Mapped[float | None] = mapped_column(Float, nullable=True)
+    points: Mapped[int] = mapped_column(Integer)
+
+    flow: Mapped[SoilFlow] = relationship(back_populates="fits")
+
+
+class SoilFlowFailure(Base):
+    """Side-camera frames of a raw-file version that could not be analysed, and why."""
+
+    __tablename__ = "soil_flow_failure"
+    __table_args__ = (UniqueConstraint("raw_file_id", "params_sha256"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    raw_file_id: Mapped[int] = mapped_column(ForeignKey("raw_file.id"))
+    params_sha256: Mapped[str] = mapped_column(String(64))
+    channel: Mapped[str] = mapped_column(String(200))
+    problem: Mapped[str] = mapped_column(String(2000))
+    processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+
+    raw_file: Mapped[RawFile] = relationship()
     processing: Mapped[ProcessingRecord] = relationship()

@@ -17,6 +17,7 @@ from virtual_testbed.law import PerformanceLaw, bb2_sand_law
 from virtual_testbed.measure import RawRun, measure
 from virtual_testbed.rig import BB2_WHEEL, Suspension, Timeline, Wheel
 from virtual_testbed.sensors import Rates, SensorModel
+from virtual_testbed.side_camera import SIDE_TOPIC, SideCamera, camera_record, side_frames
 from virtual_testbed.simulate import Dynamics, simulate_true_run
 from virtual_testbed.track_photos import TRACK_TOPIC, photo_seed, track_photos
 from virtual_testbed.truth import truth_record
@@ -34,6 +35,8 @@ class Testbed:
     lateral: LateralLaw = LateralLaw()
     #: ground scale of the track photos (px per m at the image centre)
     track_px_per_m: float = 700.0
+    #: the side camera of runs with ``side_camera_frames``
+    side_camera: SideCamera = SideCamera()
     wheel: Wheel = BB2_WHEEL
     suspension: Suspension = Suspension()
     timeline: Timeline = Timeline()
@@ -98,12 +101,20 @@ def make_run(condition: RunCondition, seed: int, start: str, testbed: Testbed,
                       metadata={**raw.metadata, "camera_track": {"px_per_m": tb.track_px_per_m}})
         photos_truth = {"count": len(photos), "px_per_m": tb.track_px_per_m,
                         "slip": true_run.steady["slip"], "t_ns": [p.t_ns for p in photos]}
+    side_truth = None
+    if condition.side_camera_frames:
+        frames, side_truth = side_frames(true_run, tb.wheel, tb.side_camera,
+                                         condition.side_camera_frames, photo_seed(rng))
+        raw = replace(raw, images={**raw.images, SIDE_TOPIC: frames},
+                      metadata={**raw.metadata, "camera": camera_record(tb.side_camera)})
     truth = truth_record(true_run, radius_m=tb.wheel.radius_m, grouser_count=tb.wheel.grouser_count,
                          raw_file=raw_name(condition.run_id, form), form=form, seed=seed,
                          law_parameters=tb.law.parameters(), dynamics=tb.dynamics,
                          sensors=tb.sensors, rates=tb.rates, measurement_record=measurement.record)
     if photos_truth:
         truth["track_photos"] = photos_truth
+    if side_truth:
+        truth["side_camera"] = side_truth
     return raw, truth
 
 

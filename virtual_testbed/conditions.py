@@ -28,6 +28,8 @@ class RunCondition:
     steer_deg: float | None = None
     #: photos of the track taken after the run (``/camera/track``), driving slip only
     track_photos: int = 0
+    #: side-camera frames (``/camera/side``) in the stable phase, soil flow under the wheel
+    side_camera_frames: int = 0
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -39,5 +41,7 @@ class RunCondition:
             raise ValueError("steer_deg is required for steered runs and only there")
         if self.track_photos and not (self.mode in SLIP_IMPOSED and self.slip_setpoint >= 0):
             raise ValueError("track photos are rendered for a driving slip set point >= 0")
+        if self.side_camera_frames < 0 or self.side_camera_frames == 1:
+            raise ValueError("side_camera_frames is 0 or at least 2 (a flow needs a frame pair)")
         if self.slip_setpoint is not None and not -1.0 < self.slip_setpoint < 1.0:
             raise ValueError(f"slip_setpoint {self.slip_setpoint} outside (-1, 1)")

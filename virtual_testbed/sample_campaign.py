@@ -8,13 +8,16 @@ rewrites ``sample_data/`` bit for bit. Contents (see docs/virtual-testbed.md):
 - a 120 N validation series, multipass 0, 5 slips between the others (MCAP form);
 - one towed and one free-sled run per load, multipass 0 (CSV form);
 - one steered run, 180 N, slip 0.2 at a 10 degree slip angle (MCAP form);
-- a photo of the track (``/camera/track``) after three 180 N runs (slip 10, 35, 60 %).
+- a photo of the track (``/camera/track``) after three 180 N runs (slip 10, 35, 60 %);
+- side-camera frames (``/camera/side``) of the soil flow under the wheel in the stable phase
+  of two 180 N runs: slip 35 % (MCAP) and the free sled (CSV).
 """
 
 from __future__ import annotations
 
 import argparse
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 from virtual_testbed.campaign import Testbed, generate_campaign
@@ -27,6 +30,9 @@ MULTIPASSES = (0, 1)
 SLIPS = (-0.10, 0.0, 0.05, 0.10, 0.20, 0.35, 0.60, 0.90)
 #: runs whose track is photographed after the run (image slip beside encoder slip)
 PHOTOGRAPHED = {(180.0, 0, 0.10), (180.0, 0, 0.35), (180.0, 0, 0.60)}
+#: runs filmed by the side camera (soil flow), and how many frames each (6 keep the sample small)
+FILMED = ("L180_MP0_SC_s+035", "L180_MP0_FS")
+SIDE_CAMERA_FRAMES = 6
 VALIDATION_LOAD_N = 120.0
 VALIDATION_SLIPS = (-0.05, 0.03, 0.15, 0.45, 0.75)
 #: Modest rates keep the committed sample small; the grouser frequency is below 2 Hz.
@@ -59,7 +65,8 @@ def sample_conditions() -> list[tuple[RunCondition, str]]:
                  for mode in ("towed", "free_sled")]
     runs.append((RunCondition(run_id(180.0, 0, "steered", 0.2) + "_b10", "steered", 180.0, 0, 0.2,
                               steer_deg=10.0), "mcap"))
-    return runs
+    return [(replace(c, side_camera_frames=SIDE_CAMERA_FRAMES) if c.run_id in FILMED else c, form)
+            for c, form in runs]
 
 
 def generate_sample(out_dir: Path, seed: int = SEED) -> None:
