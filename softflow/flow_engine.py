@@ -2,49 +2,50 @@
 
 Default engine ``deform-lk`` (chosen by measurement, table below):
 
-1. frames normalised by local mean and standard deviation (Gaussian 3 px, soil
-   pixels only), which removes illumination flicker and glass-wall smudges;
-2. predictor: OpenCV DIS (Kroeger et al. 2016, "Fast optical flow using dense
-   inverse search"), fast preset, coarse to fine, so large displacements are found;
+1. frames normalised by local mean and standard deviation (11 px box, soil pixels
+   only), which removes illumination flicker and glass-wall smudges;
+2. predictor at half resolution: OpenCV DIS (Kroeger et al. 2016, "Fast optical flow
+   using dense inverse search"), ultrafast preset, coarse to fine, so large
+   displacements are found; then one fixed-window deformation pass at half resolution;
 3. iterative image deformation (Scarano 2002, "Iterative image deformation methods
-   in PIV"): frame b is warped back onto frame a by the current estimate (bicubic;
-   sample positions rounded to OpenCV's 1/32 px grid *before* warping, so the warp
-   is known exactly) and the linearised brightness constancy is solved for the
-   whole displacement in a window around each pixel (Lucas & Kanade 1981),
-   ``sum w g g^T u = sum w g (a - b_w + g . u_w)`` with ``g`` the gradient of the
-   mean of both images. One pass with a fixed window, then
-4. a last pass with windows of six sizes (stack blur, Gaussian-like tent kernels,
-   2-9 px standard deviation) and, per pixel, the largest window whose 95 %-ish
-   confidence interval still intersects those of all smaller ones: the
-   intersection-of-confidence-intervals rule (Katkovnik 1999, "A new method for
-   varying adaptive bandwidth selection"; Katkovnik, Egiazarian & Astola 2002). Small
-   windows where the velocity gradient is steep (at the rim), large ones in the far
-   field: that halves the window bias near the wheel and the noise far from it.
-   Interval half-width ``gamma * s / sqrt(n_eff) * sqrt(diag(M^-1))`` with ``s`` the
-   residual brightness noise of the pass and ``n_eff`` the window's effective sample
-   count.
+   in PIV") at full resolution: frame b is sampled at ``x + u`` by quintic B-spline
+   interpolation (:mod:`softflow.bspline_warp`; positions exact) and the linearised
+   brightness constancy is solved for the whole displacement in a window around each
+   point of a 2 px grid (Lucas & Kanade 1981),
+   ``sum w g g^T u = sum w g (a - b_w + g . u_w)`` with ``g`` the gradient of the mean
+   of both images, taken from the same spline model (its derivative), so one update
+   lands on the displacement: with 4th-order finite differences it fell short by a
+   few per cent of the predictor's error, which took a second pass;
+4. windows of three sizes (stack blur, tent kernels) and, per grid point, the largest
+   window whose 95 %-ish confidence interval still intersects those of the smaller
+   ones: the intersection-of-confidence-intervals rule (Katkovnik 1999, "A new method
+   for varying adaptive bandwidth selection"; Katkovnik, Egiazarian & Astola 2002).
+   Small windows where the velocity gradient is steep (at the rim), large ones in the
+   far field. Interval half-width ``gamma * s / sqrt(n_eff) * sqrt(diag(M^-1))`` with
+   ``s`` the residual brightness noise of the pass and ``n_eff`` the window's effective
+   sample count.
 
 Measured on a 1-megapixel :mod:`virtual_testbed.flow_render` scene (grousered wheel,
 noise 2 grey levels, flicker, smudges; soil pixels 8 px or more from the wheel; 3
-pairs; 2-core machine; ``python -m bench softflow`` repeats it beside OpenPIV):
+pairs; 2-core machine, quiet; ``python -m bench softflow`` repeats it beside OpenPIV):
 
-====================================================  =======  ========  ==============
-engine                                                RMS px   bias px   CPU s/pair (1
-                                                                         thread)
-====================================================  =======  ========  ==============
-deform-lk: DIS + fixed pass + ICI pass (default)      0.0090   0.0018    0.11
-same, one Gaussian window sigma 5 px (no ICI)         0.0109   0.0001    0.11
-same, update added to the un-quantised estimate       0.0197   --        --
-no fixed pass (DIS straight to the ICI pass)          0.0135   0.0006    0.12
-Farneback win 21 + 1 deformation pass (scipy warp)    0.018    0.0001    0.85
-Farneback win 21 (``farneback``)                      0.0194   0.0019    0.33
-DIS medium (``dis``)                                  0.026    0.0066    0.05
-OpenPIV 0.26 windef 64/32/16 (at its 16 px grid)      0.0110   0.0031    0.6-0.8
-====================================================  =======  ========  ==============
+=====================================================  =======  ========  ============
+engine                                                 RMS px   bias px   ms/pair, 1
+                                                                          thread (2)
+=====================================================  =======  ========  ============
+deform-lk (default)                                    0.0090   0.0013    61 (42)
+same, 4th-order differences for ``g``                  0.0101   0.0018    59
+cubic B-spline and 4th-order differences               0.0098   0.0019    56
+previous default: full-resolution DIS fast + fixed     0.0091   0.0021    97 (72)
+pass + 6-window ICI pass, OpenCV Lanczos4 warp
+Farneback win 21 (``farneback``)                       0.0194   0.0019    330
+DIS medium (``dis``)                                   0.026    0.0066    50
+OpenPIV 0.26 windef 64/32/16 (at its 16 px grid)       0.0110   0.0031    600
+=====================================================  =======  ========  ============
 
-The first (fixed-window) pass warps by cubic interpolation, the last by Lanczos4:
-at a uniform quarter-pixel shift, cubic in both left 0.0095 px of peak-locking bias,
-Lanczos4 in the last pass 0.0003-0.0011 px (linear in the first pass: 0.004 px).
+Sub-pixel (peak-locking) bias at uniform shifts of 0.25, 0.5, 0.75 and 1.25 px:
+at most 0.0016 px (quintic spline, spline gradient); 4th-order differences with one
+pass: up to 0.0062 px; cubic B-spline and differences: up to 0.011 px.
 ``farneback`` and ``dis`` remain selectable (no deformation passes) for comparison.
 Outliers: normalised median test of Westerweel & Scarano (2005, "Universal outlier
 detection for PIV data"), on neighbours ``spacing_px`` apart, ``eps = 0.1 px``,
@@ -60,26 +61,49 @@ import cv2
 import numba
 import numpy as np
 
+from softflow import bspline_warp
+
 ENGINES = ("deform-lk", "farneback", "dis")
 GRID_PX = 2  # the windows are solved on a grid this much coarser than the pixels
 FIXED_KERNEL_PX = 11  # stack-blur size (grid points) of the fixed-window pass
-ICI_KERNELS_PX = (5, 7, 11, 15, 21, 29)  # stack-blur sizes (grid points) of the adaptive pass
-FIXED_PASS_INTERPOLATION = cv2.INTER_CUBIC  # linear left 0.004 px peak locking, cubic 0.0014
+ICI_KERNELS_PX = (5, 11, 21)  # stack-blur sizes (grid points) of the adaptive pass
 RATE_KERNELS_PX = (3,)  # one small fixed window for the decay-rate analysis (average_flow)
 ICI_GAMMA = 2.0
 NORMALISE_KERNEL_PX = 11  # box
+DIS_PRESET = cv2.DISOPTICAL_FLOW_PRESET_ULTRAFAST
 
 
-def normalise_frame(gray: np.ndarray, soil: np.ndarray | None = None) -> np.ndarray:
-    """Local contrast normalisation ``(I - mean) / std`` in a box window, 0 off the soil."""
-    f = gray.astype(np.float32)
-    w = np.ones_like(f) if soil is None else soil.astype(np.float32)
+@numba.njit(parallel=True, cache=True)
+def _standardise(gray, soil, count, sum_f, sum_ff, out):
+    """``(I - mean) / (std + 1)`` on the soil, 0 off it, from the window sums
+    (:func:`normalise_frames`)."""
+    h, w = gray.shape
+    for i in numba.prange(h):
+        for j in range(w):
+            n = count[i, j] + np.float32(1e-6)
+            mean = sum_f[i, j] / n
+            var = max(sum_ff[i, j] / n - mean * mean, np.float32(0))
+            std = np.sqrt(var) + np.float32(1)
+            out[i, j] = (np.float32(gray[i, j]) - mean) / std * soil[i, j]
+
+
+def normalise_frames(frames: tuple[np.ndarray, ...], soil: np.ndarray) -> list[np.ndarray]:
+    """Local contrast normalisation ``(I - mean) / std`` in a box window over the soil
+    pixels (``soil``, float 0/1), 0 off the soil."""
     k = (NORMALISE_KERNEL_PX, NORMALISE_KERNEL_PX)
-    fw = f * w
-    total = cv2.blur(w, k) + 1e-6
-    mean = cv2.blur(fw, k) / total
-    std = np.sqrt(np.maximum(cv2.blur(fw * f, k) / total - mean * mean, 0)) + 1.0
-    return (f - mean) / std * w
+    every = bool(soil.all())
+    count = (np.full(soil.shape, float(k[0] * k[1]), np.float32) if every
+             else cv2.boxFilter(soil, -1, k, normalize=False))
+    out = []
+    for gray in frames:
+        masked = gray if every else np.where(soil > 0, gray, 0).astype(gray.dtype)
+        if masked.dtype != np.uint8:
+            masked = masked.astype(np.float32)
+        sum_f = cv2.boxFilter(masked, cv2.CV_32F, k, normalize=False)
+        sum_ff = cv2.sqrBoxFilter(masked, cv2.CV_32F, k, normalize=False)
+        _standardise(gray, soil, count, sum_f, sum_ff, sum_f)
+        out.append(sum_f)
+    return out
 
 
 def _to_uint8(norm: np.ndarray) -> np.ndarray:
@@ -94,44 +118,33 @@ def _tent_samples(size_px: int) -> float:
 
 
 @numba.njit(parallel=True, cache=True)
-def _quantised_maps(flow, ux, uy, map_x, map_y):
-    """Displacement rounded to OpenCV's 1/32 px sampling grid, so the warp is exactly by it."""
-    h, w = ux.shape
-    for i in numba.prange(h):
-        for j in range(w):
-            ux[i, j] = np.round(flow[i, j, 0] * 32) / 32
-            uy[i, j] = np.round(flow[i, j, 1] * 32) / 32
-            map_x[i, j] = j + ux[i, j]
-            map_y[i, j] = i + uy[i, j]
+def _cell_products(gx, gy, diff, soil, flow, grid, p4, p1):
+    """LK products ``(gx^2, gx gy, gy^2, gx r)`` into p4 and ``gy r`` into p1, averaged over
+    ``grid`` x ``grid`` pixel cells (the grid of the solve; off-soil pixels count as 0).
 
-
-@numba.njit(parallel=True, cache=True)
-def _products(a, warped, soil, ux, uy, p4, p1, diff):
-    """LK products ``(gx^2, gx gy, gy^2, gx r)`` into p4, ``gy r`` into p1, ``a - b_w`` into diff.
-
-    ``g``: 4th-order central differences of the mean of both images (edges clamped);
-    ``r = a - b_w + g . u_w``, the right-hand side for the whole displacement.
+    ``g``: gradient of the mean of both images (``gx``, ``gy``: of their sum), ``diff`` = a - b_w,
+    ``r = a - b_w + g . u``: the right-hand side for the whole displacement ``u``.
     """
-    h, w = a.shape
-    for i in numba.prange(h):
-        for j in range(w):
-            d = a[i, j] - warped[i, j]
-            diff[i, j] = d
-            if soil[i, j] == 0:
-                p4[i, j, 0] = p4[i, j, 1] = p4[i, j, 2] = p4[i, j, 3] = p1[i, j] = 0.0
-                continue
-            jm2, jm1, jp1, jp2 = max(j - 2, 0), max(j - 1, 0), min(j + 1, w - 1), min(j + 2, w - 1)
-            im2, im1, ip1, ip2 = max(i - 2, 0), max(i - 1, 0), min(i + 1, h - 1), min(i + 2, h - 1)
-            gx = 0.5 * ((a[i, jm2] + warped[i, jm2]) - 8 * (a[i, jm1] + warped[i, jm1])
-                        + 8 * (a[i, jp1] + warped[i, jp1]) - (a[i, jp2] + warped[i, jp2])) / 12
-            gy = 0.5 * ((a[im2, j] + warped[im2, j]) - 8 * (a[im1, j] + warped[im1, j])
-                        + 8 * (a[ip1, j] + warped[ip1, j]) - (a[ip2, j] + warped[ip2, j])) / 12
-            r = d + gx * ux[i, j] + gy * uy[i, j]
-            p4[i, j, 0] = gx * gx
-            p4[i, j, 1] = gx * gy
-            p4[i, j, 2] = gy * gy
-            p4[i, j, 3] = gx * r
-            p1[i, j] = gy * r
+    hc, wc = p1.shape
+    scale = np.float32(1.0 / (grid * grid))
+    half = np.float32(0.5)
+    for ic in numba.prange(hc):
+        for jc in range(wc):
+            s0 = s1 = s2 = s3 = s4 = np.float32(0)
+            for i in range(ic * grid, ic * grid + grid):
+                for j in range(jc * grid, jc * grid + grid):
+                    if soil[i, j] == 0:
+                        continue
+                    x, y = half * gx[i, j], half * gy[i, j]
+                    r = diff[i, j] + x * flow[i, j, 0] + y * flow[i, j, 1]
+                    s0 += x * x
+                    s1 += x * y
+                    s2 += y * y
+                    s3 += x * r
+                    s4 += y * r
+            p4[ic, jc, 0], p4[ic, jc, 1], p4[ic, jc, 2], p4[ic, jc, 3] = (
+                s0 * scale, s1 * scale, s2 * scale, s3 * scale)
+            p1[ic, jc] = s4 * scale
 
 
 @numba.njit(parallel=True, cache=True)
@@ -166,30 +179,30 @@ def _ici_step(s4, s1, half_width_scale, lo, hi, alive, out):
             out[i, j, 0], out[i, j, 1] = ux, uy
 
 
-class _Deformer:
-    """Frame b warped onto frame a by a displacement, and the products of one LK pass."""
+@numba.njit(parallel=True, fastmath=True, cache=True)
+def _warp_against(a, b_coefficients, flow, both, diff):
+    """Frame b at ``x + flow`` (cubic B-spline): ``a + b_w`` into both, ``a - b_w`` into diff."""
+    h, w = a.shape
+    for i in numba.prange(h):
+        for j in range(w):
+            bw = bspline_warp.sample(b_coefficients, np.float32(j) + flow[i, j, 0],
+                                     np.float32(i) + flow[i, j, 1])
+            both[i, j] = a[i, j] + bw
+            diff[i, j] = a[i, j] - bw
 
-    def __init__(self, a: np.ndarray, b: np.ndarray, soil: np.ndarray):
-        self.a, self.b, self.soil = a, b, soil
-        h, w = a.shape
-        self.ux, self.uy, self.map_x, self.map_y = (np.empty((h, w), np.float32) for _ in range(4))
-        self.p4 = np.empty((h, w, 4), np.float32)
-        self.p1 = np.empty((h, w), np.float32)
-        self.diff = np.empty((h, w), np.float32)
 
-    def products(self, flow: np.ndarray, interpolation: int = cv2.INTER_LANCZOS4) -> None:
-        """Fill ``p4``, ``p1`` and ``diff`` for the warp by ``flow``."""
-        _quantised_maps(flow, self.ux, self.uy, self.map_x, self.map_y)
-        warped = cv2.remap(self.b, self.map_x, self.map_y, interpolation,
-                           borderMode=cv2.BORDER_REFLECT)
-        _products(self.a, warped, self.soil, self.ux, self.uy, self.p4, self.p1, self.diff)
-
-    def coarse_products(self) -> tuple[np.ndarray, np.ndarray]:
-        """The products averaged over ``GRID_PX`` x ``GRID_PX`` blocks: the grid of the solve."""
-        h, w = self.p1.shape
-        size = (w // GRID_PX, h // GRID_PX)
-        return (cv2.resize(self.p4, size, interpolation=cv2.INTER_AREA),
-                cv2.resize(self.p1, size, interpolation=cv2.INTER_AREA))
+def _pass_products(a: np.ndarray, b_coefficients: np.ndarray, soil: np.ndarray, flow: np.ndarray,
+                   grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Frame b warped onto frame a by ``flow``; the LK products on the ``grid`` cells, and
+    ``a - b_w`` (the residual brightness)."""
+    h, w = a.shape
+    both, diff = np.empty((h, w), np.float32), np.empty((h, w), np.float32)
+    _warp_against(a, b_coefficients, flow, both, diff)
+    p4 = np.empty((h // grid, w // grid, 4), np.float32)
+    p1 = np.empty((h // grid, w // grid), np.float32)
+    gx, gy = bspline_warp.gradient(both)
+    _cell_products(gx, gy, diff, soil, flow, grid, p4, p1)
+    return p4, p1, diff
 
 
 def _window_means(p4: np.ndarray, p1: np.ndarray, size_px: int) -> tuple[np.ndarray, np.ndarray]:
@@ -203,22 +216,27 @@ def _upsample(flow: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     return cv2.resize(flow, (shape[1], shape[0]), interpolation=cv2.INTER_LINEAR)
 
 
-def _deform_lk(a: np.ndarray, b: np.ndarray, soil: np.ndarray, flow: np.ndarray,
+def _deform_lk(a: np.ndarray, b: np.ndarray, soil: np.ndarray,
                windows: tuple[int, ...]) -> np.ndarray:
-    """A fixed-window pass, then one over ``windows`` (ICI when several): module docstring."""
-    deformer = _Deformer(a, b, soil)
-    deformer.products(flow, FIXED_PASS_INTERPOLATION)
-    p4, p1 = deformer.coarse_products()
-    hc, wc = p1.shape
-    coarse = cv2.resize(flow, (wc, hc), interpolation=cv2.INTER_AREA)
-    lo = np.full((hc, wc, 2), -np.inf, np.float32)
-    hi = np.full((hc, wc, 2), np.inf, np.float32)
-    alive = np.ones((hc, wc), np.bool_)
-    _ici_step(*_window_means(p4, p1, FIXED_KERNEL_PX), np.float32(0), lo, hi, alive, coarse)
-    deformer.products(_upsample(coarse, a.shape))
+    """Predictor and fixed-window pass at half resolution, then the full-resolution pass
+    over ``windows`` (ICI when several): module docstring."""
+    h, w = a.shape
+    half = (w // GRID_PX, h // GRID_PX)
+    a2, b2 = (cv2.resize(x, half, interpolation=cv2.INTER_AREA) for x in (a, b))
+    soil2 = (cv2.resize(soil, half, interpolation=cv2.INTER_AREA) > 0.999).astype(np.float32)
+    dis = cv2.DISOpticalFlow_create(DIS_PRESET)
+    dis.setFinestScale(1)  # of the half-resolution frames: the full frames' scale 2
+    flow2 = dis.calc(_to_uint8(a2), _to_uint8(b2), None)
+    p4, p1, _ = _pass_products(a2, bspline_warp.bspline_coefficients(b2), soil2, flow2, 1)
+    lo = np.full(flow2.shape, -np.inf, np.float32)
+    hi = np.full(flow2.shape, np.inf, np.float32)
+    alive = np.ones(flow2.shape[:2], np.bool_)
+    _ici_step(*_window_means(p4, p1, FIXED_KERNEL_PX), np.float32(0), lo, hi, alive, flow2)
+    coarse = flow2 * GRID_PX  # half-resolution pixels are the cells of the full-resolution solve
+    p4, p1, residual = _pass_products(a, bspline_warp.bspline_coefficients(b), soil,
+                                      _upsample(coarse, a.shape), GRID_PX)
     # brightness noise left after the fixed-window fit: median of squares / chi2_1 median
-    noise_var = float(np.median(deformer.diff[::4, ::4][soil[::4, ::4] > 0] ** 2) / 0.4549)
-    p4, p1 = deformer.coarse_products()
+    noise_var = float(np.median(residual[::4, ::4][soil[::4, ::4] > 0] ** 2) / 0.4549)
     alive[:] = True
     for size in windows:
         samples = _tent_samples(size) * GRID_PX ** 2
@@ -237,20 +255,18 @@ def pair_displacement_px(frame_a: np.ndarray, frame_b: np.ndarray, engine: str =
     chosen per pixel by ICI (least displacement error), one: that window everywhere.
     """
     soil_f = np.ones(frame_a.shape, np.float32) if soil is None else soil.astype(np.float32)
-    a, b = normalise_frame(frame_a, soil), normalise_frame(frame_b, soil)
+    a, b = normalise_frames((frame_a, frame_b), soil_f)
     if engine == "farneback":
         return cv2.calcOpticalFlowFarneback(_to_uint8(a), _to_uint8(b), None, 0.5, 3, 21, 5, 5,
                                             1.1, cv2.OPTFLOW_FARNEBACK_GAUSSIAN)
-    dis = cv2.DISOpticalFlow_create(cv2.DISOPTICAL_FLOW_PRESET_FAST if engine == "deform-lk"
-                                    else cv2.DISOPTICAL_FLOW_PRESET_MEDIUM)
     if engine == "dis":
+        dis = cv2.DISOpticalFlow_create(cv2.DISOPTICAL_FLOW_PRESET_MEDIUM)
         return dis.calc(_to_uint8(a), _to_uint8(b), None)
     if engine == "deform-lk":
         h, w = a.shape
         pad = ((0, -h % GRID_PX), (0, -w % GRID_PX))  # whole grid blocks
         a, b, soil_f = (np.pad(x, pad, mode="edge") for x in (a, b, soil_f))
-        flow = _deform_lk(a, b, soil_f, dis.calc(_to_uint8(a), _to_uint8(b), None), windows)
-        return flow[:h, :w]
+        return _deform_lk(a, b, soil_f, windows)[:h, :w]
     raise ValueError(f"unknown flow engine {engine!r}; known: {ENGINES}")
 
 
