@@ -37,16 +37,21 @@ def test_pair_accuracy(render, engine, rms_px, bias_px):
     assert np.mean(np.hypot(err[:, 0], err[:, 1]) > 0.5) < 0.01
 
 
-def test_deformation_removes_subpixel_bias():
-    """Uniform quarter-pixel shift: Farneback's peak-locking bias, gone after deformation."""
+@pytest.mark.parametrize("shift_px", [0.25, 0.75, 1.25])
+def test_deformation_removes_subpixel_bias(shift_px):
+    """Uniform fractional shifts: Farneback's peak-locking bias, gone after deformation
+    (quintic spline and its gradient: <= 0.0016 px measured; cubic spline 0.011 px)."""
     uniform = tuple([5000.0] * len(BETA_GRID))
-    scene = FlowScene(size_px=(192, 192), wheel_center_px=(96, -200), velocity_mps=0.25 * 25 / 1000,
-                      radial_decay_per_m=uniform, tangential_decay_per_m=uniform, smudges=0, seed=3)
+    scene = FlowScene(size_px=(192, 192), wheel_center_px=(96, -200),
+                      velocity_mps=shift_px * 25 / 1000, radial_decay_per_m=uniform,
+                      tangential_decay_per_m=uniform, smudges=0, seed=3)
     r = render_flow(scene, 2)
     m = _inner(r.soil_mask[0])
     bias = [np.mean((pair_displacement_px(*r.frames, engine=e) - r.displacement_px[0])[m][:, 0])
             for e in ("deform-lk", "farneback")]
-    assert abs(bias[0]) < 0.002 < 0.004 < abs(bias[1])
+    assert abs(bias[0]) < 0.0025
+    if shift_px == 0.25:
+        assert 0.004 < abs(bias[1])
 
 
 def test_odd_frame_size(render):
