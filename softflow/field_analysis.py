@@ -24,6 +24,10 @@ from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, pro
 from softflow.volumetric_strain import strain_by_beta
 from softflow.wheel_detect import WheelPose, soil_mask, track_wheel
 
+#: profiles start this far outside the grouser tips: the soil mask's 8 px plus the 4 px
+#: reach of the decay-rate flow window (closer, the windows are one-sided and flatten the
+#: profile: alpha3 0.5-1.5 % lower on the test scenes)
+FIT_START_PX = 12.0
 BIN_WIDTH_DEG = 10.0
 
 
@@ -112,7 +116,7 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
     sled = -far_field_velocity(v_cam, r_px)
     v_r, v_t = resolve(v_cam + sled, theta, direction)
     rim = poses[0].radius_px
-    r_min = rim + poses[0].grouser_height_px + 8.0
+    r_min = rim + poses[0].grouser_height_px + FIT_START_PX
     centres = beta_bins(BIN_WIDTH_DEG)
     width = np.deg2rad(BIN_WIDTH_DEG)
     prof_r = profiles(v_r, r_px, beta, centres, width, r_min)

@@ -2,8 +2,8 @@
 
 The soil seen through the glass is a fine grain texture; the wheel is not. A pixel
 is "smooth" where the local standard deviation of the high-passed frame is below an
-Otsu threshold (on its logarithm); the largest smooth region with its holes filled
-is the wheel. Its edge along 720 rays gives the centre (algebraic Kasa circle fit
+Otsu threshold (on its logarithm); the smooth region that is largest with its holes
+filled is the wheel. Its edge along 720 rays gives the centre (algebraic Kasa circle fit
 to the edge points near the median radius, i.e. between grousers); that edge lies
 3-4 px inside the rim (half the texture window), so the rim radius is the
 strongest radial intensity step common to all rays just outside it. Grousers are
@@ -56,14 +56,21 @@ def _smooth_pixels(gray: np.ndarray, window_px: int) -> np.ndarray:
 
 
 def smooth_region(gray: np.ndarray) -> np.ndarray:
-    """Boolean mask of the largest non-textured region (7 px window), holes filled."""
+    """Boolean mask of the non-textured region (7 px window) that covers most once its
+    holes are filled: a painted ring on the wheel can split it into an inner disc and an
+    outer annulus, and the annulus, filled, is the whole wheel."""
     smooth = cv2.morphologyEx(_smooth_pixels(gray, 7).astype(np.uint8), cv2.MORPH_OPEN,
                               np.ones((5, 5), np.uint8))
     labels, n = ndimage.label(smooth)
     if n == 0:
         raise WheelNotFoundError("no smooth (non-soil) region in the frame")
     sizes = ndimage.sum(smooth, labels, index=np.arange(1, n + 1))
-    return ndimage.binary_fill_holes(labels == (1 + int(np.argmax(sizes))))
+    best, best_area = None, 0
+    for label in 1 + np.flatnonzero(sizes >= 0.1 * sizes.max()):
+        filled = ndimage.binary_fill_holes(labels == label)
+        if filled.sum() > best_area:
+            best, best_area = filled, int(filled.sum())
+    return best
 
 
 def _edge_radii(mask: np.ndarray, center: tuple[float, float], r_max: float,

@@ -15,9 +15,9 @@ from virtual_testbed.flow_render import (FlowScene, default_radial_decay_per_m,
                                          write_flow_render)
 
 
-@pytest.fixture(scope="module")
-def smooth_wheel():
-    scene = FlowScene(seed=5)
+@pytest.fixture(scope="module", params=[5, 9])
+def smooth_wheel(request):
+    scene = FlowScene(seed=request.param)
     return scene, render_flow(scene, 10)
 
 
