@@ -162,3 +162,32 @@ def test_report_section_and_standalone_flow_of_the_stored_range(stored, campaign
     again = {(r["beta_deg"], c): r[c]["rate_per_m"] for r in json.loads(out.read_text())["per_beta"]
              for c in ("k", "alpha3") if r[c]}
     assert again == pytest.approx(stored_rates, rel=1e-9)
+
+
+def test_video_run_gives_the_numbers_of_its_png_frames(campaign, tmp_path):
+    """A CSV run whose side camera is one lossless video (``camera_side.mkv`` + ``.csv``, raw-run
+    spec) instead of PNG files: the same frames, so the same soil flow."""
+    import cv2
+
+    from ingest import read_run
+    from softflow.flow_run import run_flow
+
+    pngs = campaign / "campaign" / "FLOW_CSV"
+    video_run = tmp_path / "FLOW_VIDEO"
+    shutil.copytree(pngs, video_run)
+    files = sorted((video_run / "camera_side").iterdir(), key=lambda p: int(p.stem))
+    first = cv2.imread(str(files[0]), cv2.IMREAD_GRAYSCALE)
+    writer = cv2.VideoWriter(str(video_run / "camera_side.mkv"), cv2.VideoWriter_fourcc(*"FFV1"),
+                             3, (first.shape[1], first.shape[0]), False)
+    for f in files:
+        writer.write(cv2.imread(str(f), cv2.IMREAD_GRAYSCALE))
+    writer.release()
+    (video_run / "camera_side.csv").write_text("frame,t_s\n" + "".join(
+        f"{i},{int(f.stem) / 1e9}\n" for i, f in enumerate(files)))
+    shutil.rmtree(video_run / "camera_side")
+    by_png, by_video = (run_flow(read_run(folder), 0.0, 1e6) for folder in (pngs, video_run))
+    assert by_video.result.frame_range == by_png.result.frame_range == (0, len(files))
+    for a, b in zip(by_png.result.tangential, by_video.result.tangential):
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert b.rate_per_m == pytest.approx(a.rate_per_m, rel=1e-6)
