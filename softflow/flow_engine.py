@@ -65,7 +65,7 @@ from softflow import bspline_warp
 
 ENGINES = ("deform-lk", "farneback", "dis")
 GRID_PX = 2  # the windows are solved on a grid this much coarser than the pixels
-FIXED_KERNEL_PX = 11  # stack-blur size (grid points) of the fixed-window pass
+FIXED_KERNEL_PX = 11  # stack-blur size (half-resolution pixels) of the predictor's pass
 ICI_KERNELS_PX = (5, 11, 21)  # stack-blur sizes (grid points) of the adaptive pass
 RATE_KERNELS_PX = (3,)  # one small fixed window for the decay-rate analysis (average_flow)
 ICI_GAMMA = 2.0
@@ -181,7 +181,7 @@ def _ici_step(s4, s1, half_width_scale, lo, hi, alive, out):
 
 @numba.njit(parallel=True, fastmath=True, cache=True)
 def _warp_against(a, b_coefficients, flow, both, diff):
-    """Frame b at ``x + flow`` (cubic B-spline): ``a + b_w`` into both, ``a - b_w`` into diff."""
+    """Frame b at ``x + flow`` (quintic B-spline): ``a + b_w`` into both, ``a - b_w`` into diff."""
     h, w = a.shape
     for i in numba.prange(h):
         for j in range(w):
@@ -265,7 +265,8 @@ def pair_displacement_px(frame_a: np.ndarray, frame_b: np.ndarray, engine: str =
     if engine == "deform-lk":
         h, w = a.shape
         pad = ((0, -h % GRID_PX), (0, -w % GRID_PX))  # whole grid blocks
-        a, b, soil_f = (np.pad(x, pad, mode="edge") for x in (a, b, soil_f))
+        if pad != ((0, 0), (0, 0)):
+            a, b, soil_f = (np.pad(x, pad, mode="edge") for x in (a, b, soil_f))
         return _deform_lk(a, b, soil_f, windows)[:h, :w]
     raise ValueError(f"unknown flow engine {engine!r}; known: {ENGINES}")
 
