@@ -10,6 +10,10 @@ measured on a :mod:`virtual_testbed.flow_render` texture at quarter-pixel shifts
 0.031 px, cubic B-spline 0.0069 px, OpenCV's Keys cubic 0.011 px, quintic B-spline
 0.0013 px, OpenCV's Lanczos4 0.0006 px at twice the taps and slower here. Positions are
 used exactly, not rounded to a sampling table.
+
+Every numba kernel that calls :func:`sample` lives in this module: numba's on-disk cache
+notices a change to a kernel's own file only, so a caller elsewhere would keep running a
+stale copy of ``sample`` after it changed.
 """
 
 from __future__ import annotations
@@ -182,3 +186,16 @@ def warp(coefficients, flow):
             out[i, j] = sample(coefficients, np.float32(j) + flow[i, j, 0],
                                np.float32(i) + flow[i, j, 1])
     return out
+
+
+@numba.njit(parallel=True, fastmath=True, cache=True)
+def warp_against(reference, coefficients, flow, both, diff):
+    """The image warped by ``flow`` (as :func:`warp`) set against ``reference``:
+    ``reference + warped`` into both, ``reference - warped`` into diff (one pass)."""
+    h, w = reference.shape
+    for i in numba.prange(h):
+        for j in range(w):
+            warped = sample(coefficients, np.float32(j) + flow[i, j, 0],
+                            np.float32(i) + flow[i, j, 1])
+            both[i, j] = reference[i, j] + warped
+            diff[i, j] = reference[i, j] - warped

@@ -179,25 +179,13 @@ def _ici_step(s4, s1, half_width_scale, lo, hi, alive, out):
             out[i, j, 0], out[i, j, 1] = ux, uy
 
 
-@numba.njit(parallel=True, fastmath=True, cache=True)
-def _warp_against(a, b_coefficients, flow, both, diff):
-    """Frame b at ``x + flow`` (quintic B-spline): ``a + b_w`` into both, ``a - b_w`` into diff."""
-    h, w = a.shape
-    for i in numba.prange(h):
-        for j in range(w):
-            bw = bspline_warp.sample(b_coefficients, np.float32(j) + flow[i, j, 0],
-                                     np.float32(i) + flow[i, j, 1])
-            both[i, j] = a[i, j] + bw
-            diff[i, j] = a[i, j] - bw
-
-
 def _pass_products(a: np.ndarray, b_coefficients: np.ndarray, soil: np.ndarray, flow: np.ndarray,
                    grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Frame b warped onto frame a by ``flow``; the LK products on the ``grid`` cells, and
     ``a - b_w`` (the residual brightness)."""
     h, w = a.shape
     both, diff = np.empty((h, w), np.float32), np.empty((h, w), np.float32)
-    _warp_against(a, b_coefficients, flow, both, diff)
+    bspline_warp.warp_against(a, b_coefficients, flow, both, diff)
     p4 = np.empty((h // grid, w // grid, 4), np.float32)
     p1 = np.empty((h // grid, w // grid), np.float32)
     gx, gy = bspline_warp.gradient(both)
