@@ -33,14 +33,14 @@ pairs; 2-core machine, quiet; ``python -m bench softflow`` repeats it beside Ope
 engine                                                 RMS px   bias px   ms/pair, 1
                                                                           thread (2)
 =====================================================  =======  ========  ============
-deform-lk (default)                                    0.0090   0.0013    61 (42)
+deform-lk (default)                                    0.0090   0.0013    59 (44)
 same, 4th-order differences for ``g``                  0.0101   0.0018    59
 cubic B-spline and 4th-order differences               0.0098   0.0019    56
 previous default: full-resolution DIS fast + fixed     0.0091   0.0021    97 (72)
 pass + 6-window ICI pass, OpenCV Lanczos4 warp
-Farneback win 21 (``farneback``)                       0.0194   0.0019    330
+Farneback win 21 (``farneback``)                       0.0194   0.0019    -- (300)
 DIS medium (``dis``)                                   0.026    0.0066    50
-OpenPIV 0.26 windef 64/32/16 (at its 16 px grid)       0.0110   0.0031    600
+OpenPIV 0.26 windef 64/32/16 (at its 16 px grid)       0.0110   0.0031    550
 =====================================================  =======  ========  ============
 
 Sub-pixel (peak-locking) bias at uniform shifts of 0.25, 0.5, 0.75 and 1.25 px:
