@@ -28,7 +28,8 @@ class SideCamera:
     """The side camera: image size, scale, frame rate, where the axle is, the soil's grouser model.
 
     At 40 m/h and 800 px/m, 3 frames/s move the far soil about 3 px per frame, the
-    displacement a SOFT analysis needs (a faster camera's video would be thinned to it).
+    displacement a SOFT analysis needs (softflow pairs consecutive frames: a faster camera's
+    video has to be thinned to such a step first, docs/softflow.md).
     """
 
     size_px: tuple[int, int] = (384, 320)  # width, height
