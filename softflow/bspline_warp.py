@@ -174,24 +174,10 @@ def sample(c, x, y):
 
 
 @numba.njit(parallel=True, fastmath=True, cache=True)
-def warp(coefficients, flow):
-    """``out[i, j]`` = the image at ``(x, y) = (j + flow[i, j, 0], i + flow[i, j, 1])``.
-
-    ``coefficients``: :func:`bspline_coefficients` of the image; mirror boundaries outside.
-    """
-    h, w = coefficients.shape
-    out = np.empty((h, w), np.float32)
-    for i in numba.prange(h):
-        for j in range(w):
-            out[i, j] = sample(coefficients, np.float32(j) + flow[i, j, 0],
-                               np.float32(i) + flow[i, j, 1])
-    return out
-
-
-@numba.njit(parallel=True, fastmath=True, cache=True)
 def warp_against(reference, coefficients, flow, both, diff):
-    """The image warped by ``flow`` (as :func:`warp`) set against ``reference``:
-    ``reference + warped`` into both, ``reference - warped`` into diff (one pass)."""
+    """The image at ``(x, y) = (j + flow[i, j, 0], i + flow[i, j, 1])`` (``coefficients``:
+    :func:`bspline_coefficients` of it; mirror boundaries outside), set against
+    ``reference``: ``reference + warped`` into both, ``reference - warped`` into diff."""
     h, w = reference.shape
     for i in numba.prange(h):
         for j in range(w):

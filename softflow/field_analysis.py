@@ -22,12 +22,12 @@ from softflow.flow_engine import MeanField, average_flow
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
 from softflow.volumetric_strain import strain_by_beta
-from softflow.wheel_detect import WheelPose, soil_mask, track_wheel
+from softflow.wheel_detect import MASK_MARGIN_PX, WheelPose, soil_mask, track_wheel
 
-#: profiles start this far outside the grouser tips: the soil mask's 8 px plus the 4 px
+#: profiles start this far outside the grouser tips: the soil mask's margin plus the 4 px
 #: reach of the decay-rate flow window (closer, the windows are one-sided and flatten the
 #: profile: alpha3 0.5-1.5 % lower on the test scenes)
-FIT_START_PX = 12.0
+FIT_START_PX = MASK_MARGIN_PX + 4.0
 BIN_WIDTH_DEG = 10.0
 
 

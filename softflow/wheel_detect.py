@@ -28,6 +28,7 @@ import numpy as np
 from scipy import ndimage, stats
 
 N_RAYS = 720
+MASK_MARGIN_PX = 8.0  # soil kept this far from the grouser tips (texture window, blur)
 
 
 @dataclass
@@ -224,7 +225,8 @@ def track_wheel(frames: list[np.ndarray], direction: int = 1,
     return poses
 
 
-def soil_mask(shape: tuple[int, int], pose: WheelPose, margin_px: float = 8.0) -> np.ndarray:
+def soil_mask(shape: tuple[int, int], pose: WheelPose,
+              margin_px: float = MASK_MARGIN_PX) -> np.ndarray:
     """True on soil: outside the rim plus grouser ring plus ``margin_px``."""
     h, w = shape
     y, x = np.mgrid[0:h, 0:w]

@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from softflow.bspline_warp import bspline_coefficients, gradient, warp
+from softflow.bspline_warp import bspline_coefficients, gradient, warp_against
+
+
+def warp(coefficients, flow):
+    """The warped image alone: ``warp_against`` a zero reference gives it in ``both``."""
+    both, diff = np.empty_like(coefficients), np.empty_like(coefficients)
+    warp_against(np.zeros_like(coefficients), coefficients, flow, both, diff)
+    assert np.array_equal(diff, -both)
+    return both
 
 
 @pytest.fixture(scope="module")
