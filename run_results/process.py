@@ -97,8 +97,8 @@ def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
             out[f"{name}_peak_to_peak_{unit}"] = float(np.nanmax(wave) - np.nanmin(wave))
         else:
             out[f"{name}_peak_{unit}"] = out[f"{name}_peak_to_peak_{unit}"] = None
-    out["method"] = ("Hann zero-padded FFT peak within +-40 % of n*omega/2pi, refined by "
-                     f"least squares on a {osc.HARMONICS}-harmonic series; peaks from the "
+    out["method"] = (f"least squares on a {osc.HARMONICS}-harmonic series, global minimum on a "
+                     "grid over +-40 % of n*omega/2pi refined by Brent; peaks from the "
                      "phase-averaged waveform")
     return out, frequency
 
