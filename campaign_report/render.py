@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import re
 from datetime import UTC, datetime
-from importlib.metadata import version
 from pathlib import Path
 
 from sqlalchemy.engine import make_url
@@ -17,6 +16,7 @@ from campaign_report.html import Page, render_page
 from campaign_report.style import Palette
 from swtlab_cli.progress import progress
 from traceability import open_database
+from traceability.provenance import swtlab_version
 
 
 def page_paths(path: str | Path, names: list[str]) -> dict[str, Path]:
@@ -53,7 +53,7 @@ def build_page(session: Session, data: CampaignData, db_url: str, quiet: bool = 
             ("loads", ", ".join(f"{x:g} N" for x in data.loads)),
             ("multipass", ", ".join(str(m) for m in data.multipasses)),
             ("generated", datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
-             + f" by swtlab {version('swtlab')}")]
+             + f" by swtlab {swtlab_version()}")]
     return Page(f"SWT campaign {data.name}", meta, parts,
                 footer="Self-contained page written by swtlab report: every figure is "
                        "embedded, nothing is fetched from the network.")

@@ -39,7 +39,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from importlib.metadata import version
+    from traceability.provenance import swtlab_version
 
     from fitting import FittingError, fit_results, from_run_results
     from traceability import open_database
@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
             return exit_codes.BAD_INPUT
         stored = store_fits(session, table, fits, options)
         inputs_hash = inputs_sha256(table)
-        file_hash = write_wpm_csv(fits, args.output, inputs_hash, version("swtlab"))
+        file_hash = write_wpm_csv(fits, args.output, inputs_hash, swtlab_version())
         store_export(session, args.output, file_hash, inputs_hash, FORMAT, stored, options)
     for error in too_few:
         print(f"  not fitted: {error}")

@@ -1,4 +1,4 @@
-"""``swtlab gap-bench --n N --seed S``: the blind check of the gap diagnosis (validation.gap_bench)."""
+"""``swtlab gap-bench --n N --seed S``: the blind gap-diagnosis check (validation.gap_bench)."""
 
 from __future__ import annotations
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
@@ -12,13 +11,14 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 
 from plain_json import jsonable
+from traceability.provenance import swtlab_version
 from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
 from traceability.store import new_processing_record
 
 
 def params_sha256(parameters: dict[str, Any]) -> str:
     """Hash of the processing parameters and the swtlab version (canonical JSON)."""
-    text = json.dumps({"swtlab": version("swtlab"), **parameters}, sort_keys=True, default=str)
+    text = json.dumps({"swtlab": swtlab_version(), **parameters}, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
 
 
