@@ -117,6 +117,8 @@ class WheelModel:
                                        for x in (load_n, slip, multipass, g)))
         if np.any(arrays[0] <= 0):
             raise ValueError("load_n must be > 0")
+        if np.any(arrays[1] < -1):
+            raise ValueError("slip must be >= -1 (a locked wheel)")
         cond = Condition(*(a.copy() for a in arrays))
         soil, geo = self._soil_state(cond), self._base_geometry(cond)
         for effect in self.effects.values():
