@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 from terramechanics import SOILS, WONG_DRY_SAND, SoilParams, Wheel, WheelModel
 
 WHEEL = Wheel(radius_m=0.25, width_m=0.15)
-CMU_RUNS = Path("/work/shared/data/cmu-3d-terramechanics/smooth_runs.csv")
+CMU_RUNS = Path(__file__).resolve().parents[2] / "shared/data/cmu-3d-terramechanics/smooth_runs.csv"
 #: the CMU authors' own smooth-wheel soil (3d-terramechanics terramechanics/set_soil_params.m,
 #: 'K10_mini_smooth'): sigma = k z^n0 with k = 8e3 kN/m^(n+2), n0 = 1.4, c = 1.0 kPa,
 #: phi = 29 deg, K = 0.01 m, density 1330 kg/m^3 (their skid exponent n2 is not used here)
