@@ -117,6 +117,8 @@ class WheelModel:
                                        for x in (load_n, slip, multipass, g)))
         if np.any(arrays[0] <= 0):
             raise ValueError("load_n must be > 0")
+        if np.any(arrays[1] < -1):
+            raise ValueError("slip must be >= -1 (a locked wheel)")
         cond = Condition(*(a.copy() for a in arrays))
         soil, geo = self._soil_state(cond), self._base_geometry(cond)
         for effect in self.effects.values():
@@ -172,7 +174,7 @@ class _ContactForces:
         self.k_reece = (soil.kc / b + soil.kphi) * b ** soil.n0
         self.n = soil.n0 + soil.n_slope * np.abs(cond.slip)
         self.slip = cond.slip
-        self.vel_ratio = stress.velocity_ratio(cond.slip)
+        self.skid = cond.slip < 0
 
     def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
         soil, geo, b = self.soil, self.geo, self.width
@@ -180,19 +182,23 @@ class _ContactForces:
         r_s = r_c + geo.shear_offset_m
         theta1 = np.arccos(np.clip(1.0 - sinkage_m / r_c, -1.0, 1.0))
         theta2 = 0.0 - soil.c3 * theta1  # 0.0 - : no -0.0 in the output
-        thetam = stress.max_stress_angle(theta1, theta2, self.slip, soil.c1, soil.c2)
-        theta = np.concatenate([stress.region_grid(theta2, thetam)[0],
-                                stress.region_grid(thetam, theta1)[0]], axis=-1)
-        weights = np.concatenate([stress.region_grid(theta2, thetam)[1],
-                                  stress.region_grid(thetam, theta1)[1]], axis=-1)
+        # part I (driven): theta_m = (c1 + c2 s) theta_1; part II (braked, towed): the
+        # normal stress peaks at the transition angle, where the shear changes sign
+        thetat = np.clip(stress.transition_angle(self.slip, soil.phi_rad), theta2, theta1)
+        thetam = np.where(self.skid, thetat, stress.max_stress_angle(
+            theta1, theta2, self.slip, soil.c1, soil.c2))
+        (rear, w_rear), (front, w_front) = (stress.region_grid(theta2, thetam),
+                                            stress.region_grid(thetam, theta1))
+        theta = np.concatenate([rear, front], axis=-1)
+        weights = np.concatenate([w_rear, w_front], axis=-1)
         sigma = stress.normal_stress(theta, theta1, theta2, thetam, self.k_reece, self.n, r_c, b)
-        j = stress.shear_displacement(theta, theta1, r_s, self.vel_ratio)
+        j = self._shear_displacement(theta, theta1, thetat, r_s)
         tau = stress.shear_stress(sigma, j, soil.cohesion_pa, soil.phi_rad, soil.shear_modulus_m)
         cos, sin = np.cos(theta), np.sin(theta)
         integral = lambda f: np.sum(f * weights, axis=-1)  # noqa: E731
         thrust = b * r_s * integral(tau * cos)
         compaction = b * r_c * integral(sigma * sin)
-        j_exit = stress.shear_displacement(theta2[..., None], theta1, r_s, self.vel_ratio)[..., 0]
+        j_exit = self._shear_displacement(theta2[..., None], theta1, thetat, r_s)[..., 0]
         return {
             "fz_n": b * (r_c * integral(sigma * cos) + r_s * integral(tau * sin)),
             "dp_soil_n": thrust - compaction,
@@ -201,3 +207,10 @@ class _ContactForces:
             "theta1_rad": theta1, "theta2_rad": theta2, "thetam_rad": thetam,
             "exit_shear_displacement_m": j_exit,
         }
+
+    def _shear_displacement(self, theta, theta1, thetat, r_s):
+        """j (m): part I for driven, part II for braked or towed conditions."""
+        slip = self.slip
+        driven = stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
+        braked = stress.skid_shear_displacement(theta, theta1, thetat, r_s, np.minimum(slip, 0.0))
+        return np.where(self.skid[..., None], braked, driven)
