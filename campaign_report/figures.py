@@ -39,7 +39,8 @@ def _robust_limits(ax, values: np.ndarray) -> None:
 
 
 def _no_data(ax, text: str) -> None:
-    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4")
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4",
+            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85})
 
 
 def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
