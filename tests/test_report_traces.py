@@ -152,3 +152,39 @@ def test_report_straight_from_in_memory_results(tmp_path, monkeypatch):
     assert "in-memory pipeline results" in text and "not stored" not in text
     assert len(re.findall(r'<div class="lightbox" id="full-run-\d+"', text)) == len(RUNS)
     assert not list(tmp_path.glob(".r.html.*"))  # written atomically, no temporary left
+
+
+def test_traces_stored_are_the_processed_ones_on_every_backend(db_url, tmp_path):
+    from swtlab_cli.main import main
+
+    campaign = tmp_path / "campaign"
+    campaign.mkdir()
+    shutil.copy2(SAMPLE / RUNS[0], campaign / RUNS[0])
+    assert main(["process", str(campaign), "--db", db_url, "--quiet"]) == 0
+    processed = process_run(ingest.read_run(campaign / RUNS[0])).traces
+    stored = _stored(db_url, OK_RUN)
+    assert set(stored) == set(processed)
+    for channel, (row, t_s, values) in stored.items():
+        assert t_s.dtype == np.float64 and values.dtype == np.float32
+        assert np.array_equal(t_s, processed[channel].t_s)
+        assert np.array_equal(values, processed[channel].values, equal_nan=True)
+        assert (row.samples, row.block, row.unit) == (processed[channel].samples,
+                                                       processed[channel].block,
+                                                       processed[channel].unit)
+
+
+def test_the_report_imports_neither_the_cli_nor_the_raw_file_reader():
+    import ast
+    from pathlib import Path
+
+    import campaign_report
+
+    imported = set()
+    for path in Path(campaign_report.__file__).parent.glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                imported |= {(path.name, a.name) for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                imported.add((path.name, node.module))
+    assert ("data.py", "traceability.store_traces") in imported  # the walk sees imports
+    assert [(f, m) for f, m in imported if m.split(".")[0] in ("swtlab_cli", "ingest")] == []
