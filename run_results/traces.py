@@ -47,7 +47,7 @@ def decimate_minmax(t_s, values, max_points: int = MAX_TRACE_POINTS
         raise ValueError(f"max_points {max_points} must be at least 2")
     if t.size <= max_points:
         return t.copy(), x.copy(), 1
-    block = math.ceil(2 * t.size / max_points)
+    block = math.ceil(t.size / (max_points // 2))
     blocks = math.ceil(t.size / block)
     index = np.minimum(np.arange(blocks * block), t.size - 1).reshape(blocks, block)
     padded = x[index]

@@ -43,6 +43,9 @@ def test_minmax_decimation_by_hand():
     assert xd[4:].tolist() == [5.0, 5.0]
     td, xd, block = decimate_minmax(t, x, max_points=7)  # short enough: kept whole
     assert block == 1 and td.tolist() == t.tolist() and np.array_equal(xd, x, equal_nan=True)
+    # an odd limit: 10 samples in at most 2 blocks of 5, 4 points
+    td, xd, block = decimate_minmax(np.arange(10.0), np.arange(10.0)[::-1], max_points=5)
+    assert block == 5 and td.tolist() == [0.0, 4.0, 5.0, 9.0] and xd.tolist() == [9, 5, 4, 0]
     with pytest.raises(ValueError, match="one length"):
         decimate_minmax(t, x[:3])
 
@@ -69,9 +72,8 @@ def test_stored_traces_are_the_raw_channels_min_and_max_per_block(processed):
     t = raw["t_s"].to_numpy()
     stored = _stored(url, OK_RUN)
     assert set(stored) == set(TRACE_CHANNELS)
-    n = len(t)
-    block = math.ceil(2 * n / MAX_TRACE_POINTS)
-    assert n == 2400 and block == 3  # 800 blocks of 3 samples, 1600 points
+    n, block = len(t), 3  # 2400 samples in at most 1000 blocks: 3 a block (800), 1600 points
+    assert n == 2400
     for channel, (row, t_s, values) in stored.items():
         x = raw[channel].to_numpy()
         assert (row.samples, row.block, row.points, row.unit) == (
