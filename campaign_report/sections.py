@@ -75,8 +75,9 @@ def timeseries_section(images: Iterable[Image]) -> Section:
     return Section(TIMESERIES, "Time series per run", [Note(
         "Drawbar pull, torque, sinkage and slip as stored by processing (each channel's "
         f"minimum and maximum per block of samples, at most {MAX_TRACE_POINTS} points: the "
-        "envelope of the full signal); the stable window shaded, the dashed line its mean. Runs with no "
-        "stable phase give the reason in the title. Click a thumbnail for full size."),
+        "envelope of the full signal); the stable window shaded, the dashed line its mean. "
+        "Runs with no stable phase give the reason in the title. Click a thumbnail for full "
+        "size."),
         *images])
 
 
