@@ -15,13 +15,9 @@ from matplotlib.lines import Line2D
 from campaign_report.data import RunRecord, SetKey
 from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from fitting import CurveFit, ValidationResult, curves_by_load, interpolate_load
-from run_results.traces import TRACE_CHANNELS
+from run_results.traces import TRACE_QUANTITIES
 from wpm_export import WheelPerformanceModule
 
-#: quantity shown for a stored trace channel, where their names differ
-_SHOWN_AS = {"ty_nm": "torque_nm"}
-#: channels of the per-run time series: (trace channel, quantity shown)
-TIMESERIES = tuple((channel, _SHOWN_AS.get(channel, channel)) for channel in TRACE_CHANNELS)
 #: what an axis says for a run processed before traces were stored
 NOT_STORED = "trace not stored; re-run swtlab process"
 WINDOW_COLOUR = "#cfe3cf"
@@ -50,11 +46,11 @@ def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
     A run processed before traces were stored says so (and shows its stored DP trace, if it
     has no stable phase)."""
     fig = Figure(figsize=(8.0, 6.4))  # fixed margins: constrained layout would double the cost
-    axes = fig.subplots(len(TIMESERIES), 1, sharex=True)
+    axes = fig.subplots(len(TRACE_QUANTITIES), 1, sharex=True)
     top = 0.93 if run.status != "no_stable_phase" else 0.86
     fig.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
     colour = palette.colour(run.load_n)
-    for ax, (column, key) in zip(axes, TIMESERIES):
+    for ax, key in zip(axes, TRACE_QUANTITIES):
         q = QUANTITIES[key]
         ax.set_ylabel(q.axis_label)
         ax.grid(alpha=0.3)
@@ -64,7 +60,7 @@ def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
             if key in run.means:
                 ax.hlines(run.means[key] * q.scale, run.window_start_s, run.window_end_s,
                           colors="k", linestyles="--", lw=1.2, label="mean over window")
-        trace = None if run.traces is None else run.traces.get(column)
+        trace = None if run.traces is None else run.traces.get(key)
         old_dp = key == "dp_n" and run.traces is None and run.dp_trace
         if trace is not None:
             values = np.asarray(trace.values, float) * q.scale

@@ -9,7 +9,8 @@ set steering angle). Single-channel quantities come from the native samples, the
 resistance and sinkage from the channels' native means (``native``). Runs with track photos
 (``/camera/track``) also get ``image_slip``, the slip read from the grouser marks
 (``softflow.track_run``), beside the encoder slip. Every result carries its channels'
-decimated traces (``run_results.traces``), so plots need not read the raw file again.
+decimated traces of DP, torque, sinkage and slip (``run_results.traces``), so plots need not
+read the raw file again.
 """
 
 from __future__ import annotations
@@ -146,7 +147,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     corrections = {"tare": tare_record(run),
                    "rig_compliance": None if rig is None else rig.to_dict()}
     common = {"run_id": run.run_id, "mode": run.metadata.run.mode, "window": window,
-              "condition": _condition(run), "traces": run_traces(run.channels)}
+              "condition": _condition(run), "traces": run_traces(t, series)}
     if not window.found:
         tb, dpb = decimate_mean(t, run.channels["dp_n"].to_numpy(), DP_TRACE_POINTS)
         trace = {"t_s": tb.tolist(), "dp_n": [None if not np.isfinite(v) else float(v)

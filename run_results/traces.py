@@ -1,5 +1,7 @@
-"""Decimated channel traces of a run, kept at processing time for plots (the report's time
-series) so that nothing downstream has to read the raw file again.
+"""Decimated traces of a run's quantities against time, kept at processing time for plots
+(the report's time series) so that nothing downstream has to read the raw file again: drawbar
+pull, torque, sinkage and slip as ``process_run`` averages them (sinkage after the rig
+correction, when one is given).
 
 Min/max decimation: the samples are cut into equal blocks and each block keeps its smallest
 and its largest sample, at their own times and in time order ("MinMax" aggregation, Jugel
@@ -17,15 +19,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: channels of the stored traces (``ingest`` channel names) and their units
-TRACE_CHANNELS = {"dp_n": "N", "ty_nm": "N*m", "sinkage_m": "m", "slip": "1"}
+#: quantities of the stored traces (``process_run``'s per-sample series, after corrections)
+TRACE_QUANTITIES = ("dp_n", "torque_nm", "sinkage_m", "slip")
 #: most points kept per channel (two per block)
 MAX_TRACE_POINTS = 2000
 
 
 @dataclass(frozen=True)
 class Trace:
-    """One channel against time, decimated from ``samples`` raw samples (``block`` per pair
+    """One quantity against time, decimated from ``samples`` raw samples (``block`` per pair
     of min/max points; 1: kept whole). NaN values mark blocks with no finite sample."""
 
     t_s: np.ndarray
@@ -64,18 +66,17 @@ def decimate_minmax(t_s, values, max_points: int = MAX_TRACE_POINTS
     return t[picked], out, block
 
 
-def run_traces(channels) -> dict[str, Trace]:
-    """The :data:`TRACE_CHANNELS` of a run's channel table (``ingest`` ``Run.channels``)
-    decimated by :func:`decimate_minmax`; a channel with no finite sample is left out."""
-    t = channels["t_s"].to_numpy(float)
+def run_traces(t_s, series: dict[str, tuple[np.ndarray, str]]) -> dict[str, Trace]:
+    """The :data:`TRACE_QUANTITIES` of ``series`` (quantity -> (per-sample values, unit), as
+    ``process_run`` builds them) decimated by :func:`decimate_minmax`; a quantity with no
+    finite sample is left out."""
+    t = np.asarray(t_s, float)
     out = {}
-    for name, unit in TRACE_CHANNELS.items():
-        if name not in channels:
+    for name in TRACE_QUANTITIES:
+        if name not in series or not np.isfinite(series[name][0]).any():
             continue
-        x = channels[name].to_numpy(float)
-        if not np.isfinite(x).any():
-            continue
-        td, xd, block = decimate_minmax(t, x)
+        values, unit = series[name]
+        td, xd, block = decimate_minmax(t, values)
         out[name] = Trace(t_s=td, values=xd.astype(np.float32), unit=unit, samples=int(t.size),
                           block=block)
     return out

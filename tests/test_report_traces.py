@@ -19,7 +19,7 @@ import ingest
 from campaign_report import figures, from_results, gather, render_report, write_report
 from campaign_report.style import Palette
 from run_results import process_run
-from run_results.traces import MAX_TRACE_POINTS, TRACE_CHANNELS, decimate_minmax
+from run_results.traces import MAX_TRACE_POINTS, TRACE_QUANTITIES, decimate_minmax
 from test_report_campaign import NO_STABLE_RUN, SAMPLE, build_small_campaign
 from traceability import open_database
 from traceability.models import RawFile, Run, RunResult, RunTrace
@@ -29,6 +29,9 @@ from traceability.store_traces import unpack_arrays
 RUNS = ["L070_MP0_SC_s+020.mcap", "L070_MP0_SC_s+005.mcap", "L180_MP0_SC_s+090.mcap",
         "L070_MP0_FS"]
 OK_RUN = "L070_MP0_SC_s+020"
+#: raw channel (ingest) and unit of each traced quantity (no rig compliance in the sample)
+RAW_CHANNEL = {"dp_n": ("dp_n", "N"), "torque_nm": ("ty_nm", "N*m"),
+               "sinkage_m": ("sinkage_m", "m"), "slip": ("slip", "1")}
 
 
 def test_minmax_decimation_by_hand():
@@ -71,13 +74,14 @@ def test_stored_traces_are_the_raw_channels_min_and_max_per_block(processed):
     raw = ingest.read_run(SAMPLE / f"{OK_RUN}.mcap").channels  # the committed copy
     t = raw["t_s"].to_numpy()
     stored = _stored(url, OK_RUN)
-    assert set(stored) == set(TRACE_CHANNELS)
+    assert set(stored) == set(RAW_CHANNEL) == set(TRACE_QUANTITIES)
     n, block = len(t), 3  # 2400 samples in at most 1000 blocks: 3 a block (800), 1600 points
     assert n == 2400
-    for channel, (row, t_s, values) in stored.items():
+    for quantity, (row, t_s, values) in stored.items():
+        channel, unit = RAW_CHANNEL[quantity]
         x = raw[channel].to_numpy()
         assert (row.samples, row.block, row.points, row.unit) == (
-            n, block, 2 * math.ceil(n / block), TRACE_CHANNELS[channel])
+            n, block, 2 * math.ceil(n / block), unit)
         expected_t, expected_x = [], []
         for start in range(0, n, block):  # per block: first smallest and first largest sample
             finite = [i for i in range(start, min(start + block, n)) if np.isfinite(x[i])]
@@ -114,7 +118,7 @@ def test_report_renders_after_the_raw_files_are_gone(processed):
     palette = Palette(data.loads, data.multipasses)
     for run in data.runs:
         fig = figures.run_timeseries(run, palette)
-        for ax, (channel, _) in zip(fig.axes, figures.TIMESERIES):
+        for ax, channel in zip(fig.axes, TRACE_QUANTITIES):
             lines = [line for line in ax.lines if line.get_label() == "stored trace"]
             if channel in run.traces:  # drawn from the stored points themselves
                 assert len(lines) == 1 and len(lines[0].get_xdata()) == len(
@@ -122,7 +126,7 @@ def test_report_renders_after_the_raw_files_are_gone(processed):
             else:
                 assert [t.get_text() for t in ax.texts] == ["not measured"]
     nsp = next(r for r in data.runs if r.run_id == NO_STABLE_RUN)
-    assert nsp.status == "no_stable_phase" and set(nsp.traces) == set(TRACE_CHANNELS)
+    assert nsp.status == "no_stable_phase" and set(nsp.traces) == set(TRACE_QUANTITIES)
 
 
 def test_runs_processed_before_traces_were_stored_get_a_placeholder(processed, tmp_path):

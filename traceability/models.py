@@ -209,8 +209,8 @@ class RunQuantity(Base):
 
 
 class RunTrace(Base):
-    """One channel of a run result decimated for plots (``run_results.traces``): ``samples``
-    raw samples, ``block`` per min/max pair (1: kept whole), ``points`` stored; ``arrays`` is
+    """One quantity of a run result against time, decimated for plots (``run_results.traces``;
+    ``channel``: the quantity, e.g. ``dp_n``): ``samples`` raw samples, ``block`` per min/max pair (1: kept whole), ``points`` stored; ``arrays`` is
     a compressed npz of ``t_s`` (float64, s) and ``values`` (float32, in ``unit``)."""
 
     __tablename__ = "run_trace"
