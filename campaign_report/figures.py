@@ -61,16 +61,15 @@ def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
                 ax.hlines(run.means[key] * q.scale, run.window_start_s, run.window_end_s,
                           colors="k", linestyles="--", lw=1.2, label="mean over window")
         trace = None if run.traces is None else run.traces.get(key)
-        old_dp = key == "dp_n" and run.traces is None and run.dp_trace
         if trace is not None:
             values = np.asarray(trace.values, float) * q.scale
             ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
             _robust_limits(ax, values)
-        elif old_dp:
+            continue
+        _no_data(ax, NOT_STORED if run.traces is None else "not measured")
+        if key == "dp_n" and run.traces is None and run.dp_trace:  # older results: this only
             dp = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
             ax.plot(run.dp_trace["t_s"], dp, color="k", lw=1.0, label="stored DP trace")
-        if trace is None:
-            _no_data(ax, NOT_STORED if run.traces is None else "not measured")
     axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
     labelled = {}
     for ax in axes:
