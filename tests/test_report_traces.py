@@ -177,20 +177,3 @@ def test_traces_stored_are_the_processed_ones_on_every_backend(db_url, tmp_path)
         assert (row.samples, row.block, row.unit) == (processed[channel].samples,
                                                        processed[channel].block,
                                                        processed[channel].unit)
-
-
-def test_the_report_imports_neither_the_cli_nor_the_raw_file_reader():
-    import ast
-    from pathlib import Path
-
-    import campaign_report
-
-    imported = set()
-    for path in Path(campaign_report.__file__).parent.glob("*.py"):
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.Import):
-                imported |= {(path.name, a.name) for a in node.names}
-            elif isinstance(node, ast.ImportFrom) and node.module:
-                imported.add((path.name, node.module))
-    assert ("data.py", "traceability.store_traces") in imported  # the walk sees imports
-    assert [(f, m) for f, m in imported if m.split(".")[0] in ("swtlab_cli", "ingest")] == []

@@ -210,8 +210,9 @@ class RunQuantity(Base):
 
 class RunTrace(Base):
     """One quantity of a run result against time, decimated for plots (``run_results.traces``;
-    ``channel``: the quantity, e.g. ``dp_n``): ``samples`` raw samples, ``block`` per min/max pair (1: kept whole), ``points`` stored; ``arrays`` is
-    a compressed npz of ``t_s`` (float64, s) and ``values`` (float32, in ``unit``)."""
+    ``channel``: the quantity, e.g. ``dp_n``): ``samples`` raw samples, ``block`` samples per
+    min/max pair (1: kept whole), ``points`` stored; ``arrays`` is a compressed npz of ``t_s``
+    (float64, s) and ``values`` (float32, in ``unit``)."""
 
     __tablename__ = "run_trace"
     __table_args__ = (UniqueConstraint("run_result_id", "channel"),)
