@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from terramechanics import EFFECTS, LETE_SAND, Wheel, WheelModel, load_model
-from terramechanics.effects import Bulldozing, Grousers, make_effect
+from terramechanics.effects import BulldozingBekker1969, GrousersBekker1956, make_effect
 from terramechanics.model_file import SHIPPED_MODELS
 
 BB2_FILE = SHIPPED_MODELS / "bb2_sand.toml"
@@ -111,14 +111,14 @@ def test_bulldozing_adds_resistance():
     np.testing.assert_allclose(on["resistance_n"] - off["resistance_n"], on["bulldozing_n"])
     np.testing.assert_allclose(off["dp_n"] - on["dp_n"], on["bulldozing_n"])
     assert np.all(np.diff(on["bulldozing_n"]) > 0)  # deeper rut, more soil pushed
-    half = model.with_effects(bulldozing=Bulldozing(coefficient=0.5)).curves(180.0, SLIPS)
+    half = model.with_effects(bulldozing=BulldozingBekker1969(coefficient=0.5)).curves(180.0, SLIPS)
     np.testing.assert_allclose(half["bulldozing_n"], 0.5 * on["bulldozing_n"])
 
 
 def test_switching_and_parameters(bb2):
     assert list(bb2.effects) == ["grousers", "slip_sinkage", "wheel_flexibility", "multipass"]
     changed = bb2.with_effects(grousers={"shear_radius_factor": 1.0}, bulldozing=True)
-    assert changed.effects["grousers"] == Grousers(shear_radius_factor=1.0)
+    assert changed.effects["grousers"] == GrousersBekker1956(shear_radius_factor=1.0)
     assert "bulldozing" in changed.effects and "bulldozing" not in bb2.effects
     params = changed.parameters()
     assert params["effects.grousers.shear_radius_factor"] == 1.0 and params["soil.kphi"] == 1.8e7
@@ -130,7 +130,7 @@ def test_switching_and_parameters(bb2):
     with pytest.raises(KeyError):
         bb2.with_parameters({"tyre.pressure": 1.0})
     with pytest.raises(KeyError):
-        WheelModel(bb2.wheel, bb2.soil, effects={"magic": Grousers()})
+        WheelModel(bb2.wheel, bb2.soil, effects={"magic": GrousersBekker1956()})
 
 
 def test_every_effect_on_stays_in_equilibrium(bb2):
