@@ -82,7 +82,7 @@ def test_without_the_contrast_the_call_is_inconclusive_with_a_test_to_run():
     report = diagnose(points, Simulated(BASE), ["grousers", "slip_sinkage"], FAST)
     assert report["verdict"] == "inconclusive"
     assert report["folds"][0].startswith("slip band")
-    assert "only 3.1 SE" in report["decision"]["reason"]
+    assert "only 3.4 SE" in report["decision"]["reason"]
     test = report["decision"]["separating_test"]
     assert test["test"] == "add skid (braked) slips (-0.5, -0.2)"
     assert test["separation_sigma"] > 2.0
