@@ -20,6 +20,7 @@ from terramechanics.wheel import Wheel
 __all__ = [
     "DEFAULT_LAWS", "EARTH_GRAVITY_MPS2", "EFFECTS", "Effect", "LAWS", "LETE_SAND",
     "LUNAR_NOMINAL", "ModelLaw", "SOILS", "SoilParams", "WONG_DRY_SAND", "Wheel", "WheelModel",
-    "drucker_prager_to_mohr_coulomb", "law_class", "load_model", "make_effect", "model_from_dict", "model_to_dict",
-    "mohr_coulomb_to_drucker_prager", "save_model", "shipped_model",
+    "drucker_prager_to_mohr_coulomb", "law_class", "load_model", "make_effect",
+    "model_from_dict", "model_to_dict", "mohr_coulomb_to_drucker_prager", "save_model",
+    "shipped_model",
 ]
