@@ -14,6 +14,7 @@ from terramechanics.effects.bulldozing_bekker1969 import BulldozingBekker1969
 from terramechanics.effects.bulldozing_rankine_terzaghi1943 import BulldozingRankineTerzaghi1943
 from terramechanics.effects.grousers_bekker1956 import GrousersBekker1956
 from terramechanics.effects.grousers_ding2011 import GrousersDing2011
+from terramechanics.effects.multipass_krenn_hirzinger2009 import MultipassKrennHirzinger2009
 from terramechanics.effects.multipass_wong2010 import MultipassWong2010
 from terramechanics.effects.reduced_gravity_reece1965 import ReducedGravityReece1965
 from terramechanics.effects.reduced_gravity_wong_kobayashi2012 import (
@@ -26,8 +27,8 @@ from terramechanics.effects.wheel_flexibility_wong2010 import WheelFlexibilityWo
 _ALL: tuple[type[Effect], ...] = (
     GrousersBekker1956, GrousersDing2011, SlipSinkageDing2011, SlipSinkageLyasko2010,
     ReducedGravityWongKobayashi2012, ReducedGravityReece1965, WheelFlexibilityWong2010,
-    WheelFlexibilityBekker1969, MultipassWong2010, BulldozingBekker1969,
-    BulldozingRankineTerzaghi1943)
+    WheelFlexibilityBekker1969, MultipassWong2010, MultipassKrennHirzinger2009,
+    BulldozingBekker1969, BulldozingRankineTerzaghi1943)
 
 #: effect -> law -> class, effects in the vocabulary's order
 LAWS: dict[str, dict[str, type[Effect]]] = {}
