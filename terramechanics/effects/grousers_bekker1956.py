@@ -1,20 +1,21 @@
-"""Grousers after Bekker: shear at the grouser tips plus the side shear of the soil blocks.
+"""Grousers after Bekker: shear through the grouser tips plus the side shear of the soil blocks.
 
 Bekker (1956) "Theory of land locomotion", ch. 8; Wong, Theory of Ground Vehicles (4th
-ed. 2008), sec. 2.4: the soil between the grousers moves with the wheel, so it shears on
-the surface through the grouser tips and, at both wheel edges, on the two sides of the
-soil blocks; the thrust of a grousered running gear is::
+ed. 2008), ch. 2 (tractive effort of a track with grousers): the soil between the
+grousers moves with the running gear, so it shears on the surface through the grouser
+tips and, at both edges, on the two vertical sides of the soil blocks (height h); the
+sides carry the full cohesion but only part of the normal stress::
 
-    F = (A c + W tan phi)(1 + 0.64 (h/b) arccot(h/b))
+    F = b l c (1 + 2h/b) + W tan(phi) (1 + 0.64 (h/b) arccot(h/b))
 
 Here the shear acts on the radius ``r_s = r + lambda h`` (lambda = 1: the tip surface
 of Bekker's picture; Ding, Gao, Deng & Tao 2011, J. Terramech. 48(1):27-45, fit
-0 <= lambda <= 1 per wheel), and the side-shear factor multiplies the shear strength
-``c + sigma tan phi`` of the contact (``c`` and ``tan phi`` scaled). The grouser faces
-add nothing else: their push on the trapped soil is what this shear carries (adding a
-passive earth pressure per grouser on top would count the grousers twice). Derived for
-track grousers in cohesive-frictional soils with the grouser spacing shorter than the
-contact; it holds for dense lugs (several in contact), not for one or two.
+0 <= lambda <= 1 per wheel), and the two factors multiply ``c`` and ``tan phi`` of the
+contact's shear strength (the bulldozing laws then see the same strengthened soil).
+The grouser faces add nothing else: their push on the trapped soil is what this shear
+carries (a passive earth pressure per grouser on top would count the grousers twice).
+Derived for track grousers in cohesive-frictional soils; it holds for dense grousers
+(several in contact, spacing short against the contact), not for one or two.
 """
 
 from __future__ import annotations
@@ -26,10 +27,13 @@ import numpy as np
 from terramechanics.effects.base import Effect, FitParam
 
 
-def side_shear_factor(height_m: float, width_m: float) -> float:
-    """Bekker's ``1 + 0.64 (h/b) arccot(h/b)`` (1 for h = 0)."""
+def side_shear_factors(height_m: float, width_m: float) -> tuple[float, float]:
+    """Bekker's factors on cohesion ``1 + 2h/b`` and on friction ``1 + 0.64 (h/b)
+    arccot(h/b)`` (both 1 for h = 0)."""
     ratio = height_m / width_m
-    return 1.0 + 0.64 * ratio * np.arctan2(1.0, ratio) if ratio > 0 else 1.0
+    if ratio <= 0:
+        return 1.0, 1.0
+    return 1.0 + 2.0 * ratio, 1.0 + 0.64 * ratio * np.arctan2(1.0, ratio)
 
 
 @dataclass(frozen=True)
@@ -42,9 +46,9 @@ class GrousersBekker1956(Effect):
     fit = (FitParam("shear_radius_factor", 0.5, 0.0, 1.5),)
 
     def soil(self, soil, cond, wheel):
-        factor = side_shear_factor(wheel.grouser_height_m, wheel.width_m)
-        return replace(soil, cohesion_pa=soil.cohesion_pa * factor,
-                       phi_rad=np.arctan(factor * np.tan(soil.phi_rad)))
+        on_c, on_tan_phi = side_shear_factors(wheel.grouser_height_m, wheel.width_m)
+        return replace(soil, cohesion_pa=soil.cohesion_pa * on_c,
+                       phi_rad=np.arctan(on_tan_phi * np.tan(soil.phi_rad)))
 
     def geometry(self, geo, soil, cond, wheel):
         offset = self.shear_radius_factor * wheel.grouser_height_m

@@ -10,6 +10,8 @@ Here the soil under the wheel is softened so that Bekker's rigid-wheel sinkage, 
 goes as ``k^(-1/(n + 1/2))`` at a fixed load (Bekker 1956), grows by ``K_s^kappa``:
 ``kc, kphi -> kc, kphi K_s^(-kappa (n + 1/2))`` (kappa = 1 as published; in the
 Wong-Reece integrals the sinkage follows within a few per cent). |i| on the skid branch.
+The coefficient's form is quoted from the paper as cited; the swtlab tests check the
+law against it, not against Lyasko's own data.
 """
 
 from __future__ import annotations
