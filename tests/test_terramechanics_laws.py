@@ -44,6 +44,14 @@ def test_registry_laws_declare_source_and_fit_parameters():
         law_class("grousers", "magic1999")
 
 
+@pytest.mark.parametrize("name, law", [(n, law) for n, laws in LAWS.items() for law in laws])
+def test_every_law_stays_in_vertical_equilibrium(name, law):
+    model = tm.shipped_model("bb2_sand").with_effects(**{name: {"law": law}})
+    out = model.curves(np.array([70.0, 300.0])[:, None], np.linspace(-0.5, 0.9, 15),
+                       multipass=1, gravity_mps2=3.71)
+    assert out["converged"].all()
+
+
 def test_model_file_picks_the_law_and_old_files_get_the_default():
     tables = {"wheel": {"radius_m": 0.1, "width_m": 0.08}, "soil": {"preset": "lete_sand"},
               "effects": {"grousers": {"law": "ding2011", "lug_sinkage_gain": 2.0},
