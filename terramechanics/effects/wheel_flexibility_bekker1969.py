@@ -1,16 +1,17 @@
 """Flexible wheel after Bekker: a flat contact at the wheel's ground pressure.
 
-Bekker (1969) "Introduction to terrain-vehicle systems", ch. 6; Wong, Theory of Ground
-Vehicles (4th ed. 2008), sec. 2.7.2: a wheel whose ground pressure ``p_g`` (inflation
+Bekker (1969) "Introduction to terrain-vehicle systems"; Wong, Theory of Ground
+Vehicles (4th ed. 2008), ch. 2 (motion resistance of a tyre): a wheel whose ground pressure ``p_g`` (inflation
 plus carcass stiffness, p_i + p_c) is below the pressure the rigid wheel would put on
 the soil, ``p_gcr = k z0^n`` with Bekker's rigid-wheel sinkage
 ``z0 = (3 W / ((3 - n) b k sqrt(D)))^(2/(2n + 1))``, ``k = kc/b + kphi``, flattens:
 the flat part carries the load at ``p_g``, so it is ``l = W/(b p_g)`` long, and the
 wheel deflects by the chord height ``delta = r - sqrt(r^2 - l^2/4)``. Above p_gcr the
 wheel stays rigid. The deflected wheel enters the stress integrals as the equivalent
-rigid wheel of the same contact length (``Geometry.contact_radius_m``). Bekker fitted
-this to pneumatic tyres on soft soils; it holds while the flat part is shorter than
-the wheel diameter (delta capped at r/2 here).
+rigid wheel of the same contact length (``Geometry.contact_radius_m``). Bekker's
+criterion for pneumatic tyres on soft soil (p_c from tyre tests); it holds while the
+flat part is shorter than the wheel diameter (delta capped at r/2 here) and for wheels
+whose carcass supports the load as a membrane (not for stiff-spoked metal wheels).
 """
 
 from __future__ import annotations
