@@ -3,9 +3,11 @@
 Lyasko (2010) "Slip sinkage effect in soil-vehicle mechanics", J. Terramechanics
 47(1):21-31: the sinkage of a slipping running gear is its static (zero-slip) sinkage
 times ``K_s = (1 + i)/(1 - 0.5 i)`` at slip i (1 at rest, 2.3 at i = 0.6, 4 at i = 1),
-from the shear-induced loss of bearing of the soil under the running gear; compared
-on tracked and wheeled vehicles in sands and loams (Yang, Lin, Zhang & Wang 2016,
-J. Southeast Univ. 32(2), found it the best of three slip-sinkage laws on a vehicle).
+from the shear-induced loss of bearing of the soil under the running gear, for
+off-road running gears on soft soils (Yang, Lin, Zhang & Wang 2016, J. Southeast Univ.
+32(2):201-207, found it the best of three slip-sinkage laws on a real vehicle). No
+soil constant: it holds where the soil's bearing loss with slip is of the average
+kind, and overstates it on firm soils that sink little with slip.
 Here the soil under the wheel is softened so that Bekker's rigid-wheel sinkage, which
 goes as ``k^(-1/(n + 1/2))`` at a fixed load (Bekker 1956), grows by ``K_s^kappa``:
 ``kc, kphi -> kc, kphi K_s^(-kappa (n + 1/2))`` (kappa = 1 as published; in the
