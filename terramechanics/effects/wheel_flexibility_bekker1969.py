@@ -1,9 +1,9 @@
 """Flexible wheel after Bekker: a flat contact at the wheel's ground pressure.
 
 Bekker (1969) "Introduction to terrain-vehicle systems"; Wong, Theory of Ground
-Vehicles (4th ed. 2008), ch. 2 (motion resistance of a tyre): a wheel whose ground pressure ``p_g`` (inflation
-plus carcass stiffness, p_i + p_c) is below the pressure the rigid wheel would put on
-the soil, ``p_gcr = k z0^n`` with Bekker's rigid-wheel sinkage
+Vehicles (4th ed. 2008), ch. 2 (motion resistance of a tyre): a wheel whose ground
+pressure ``p_g`` (inflation plus carcass stiffness, p_i + p_c) is below the pressure
+the rigid wheel would put on the soil, ``p_gcr = k z0^n`` with Bekker's rigid-wheel sinkage
 ``z0 = (3 W / ((3 - n) b k sqrt(D)))^(2/(2n + 1))``, ``k = kc/b + kphi``, flattens:
 the flat part carries the load at ``p_g``, so it is ``l = W/(b p_g)`` long, and the
 wheel deflects by the chord height ``delta = r - sqrt(r^2 - l^2/4)``. Above p_gcr the
