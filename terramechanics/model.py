@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from terramechanics import stress
-from terramechanics.effects import EFFECTS, Effect, make_effect
+from terramechanics.effects import EFFECTS, LAWS, Effect, make_effect
 from terramechanics.equilibrium import solve_increasing
 from terramechanics.soil import SoilParams
 from terramechanics.state import (EARTH_GRAVITY_MPS2, Condition, Contact, Geometry,
@@ -48,7 +48,9 @@ class WheelModel:
     # -- switching effects and parameters -------------------------------------------------
     def with_effects(self, **changes: bool | dict | Effect | None) -> WheelModel:
         """Switch effects: ``True`` on (current or default parameters), ``False``/``None``
-        off, a dict of parameters (merged into the current ones) or an ``Effect``."""
+        off, a dict of parameters (merged into the current ones; a ``"law"`` key picks
+        another law of the effect, with its defaults for what the dict does not name)
+        or an ``Effect``."""
         effects = dict(self.effects)
         for name, change in changes.items():
             if change is None or change is False:
@@ -57,9 +59,12 @@ class WheelModel:
                 effects[name] = effects.get(name) or make_effect(name)
             elif isinstance(change, Effect):
                 effects[name] = change
+            elif "law" in change and change["law"] != getattr(effects.get(name), "law", None):
+                effects[name] = make_effect(name, **change)
             else:
-                current = effects.get(name) or make_effect(name)
-                effects[name] = replace(current, **change)
+                current = effects.get(name) or make_effect(name, change.get("law"))
+                effects[name] = replace(current, **{k: v for k, v in change.items()
+                                                    if k != "law"})
         return replace(self, effects=effects)
 
     def with_soil(self, **changes: float) -> WheelModel:
@@ -123,7 +128,8 @@ class WheelModel:
         soil, geo = self._soil_state(cond), self._base_geometry(cond)
         for effect in self.effects.values():
             soil = effect.soil(soil, cond, self.wheel)
-            geo = effect.geometry(geo, cond, self.wheel)
+        for effect in self.effects.values():  # geometry sees the soil all effects made
+            geo = effect.geometry(geo, soil, cond, self.wheel)
         contact_forces = _ContactForces(soil, geo, cond)
         z_max = np.full(cond.slip.shape, self.wheel.radius_m)
         sinkage, residual = solve_increasing(lambda z: contact_forces(z)["fz_n"],
@@ -132,7 +138,8 @@ class WheelModel:
         out = contact_forces(sinkage)
         contact = Contact(sinkage, out["theta1_rad"], out["theta2_rad"], out["thetam_rad"],
                           out.pop("exit_shear_displacement_m"))
-        terms = {t: np.zeros(cond.slip.shape) for cls in EFFECTS.values() for t in cls.terms}
+        terms = {t: np.zeros(cond.slip.shape)
+                 for laws in LAWS.values() for cls in laws.values() for t in cls.terms}
         dp, torque = out.pop("dp_soil_n"), out.pop("torque_soil_nm")
         for effect in self.effects.values():
             extra = effect.forces(contact, soil, geo, cond, self.wheel)
@@ -142,7 +149,7 @@ class WheelModel:
             "load_n": cond.load_n, "slip": cond.slip, "multipass": cond.multipass,
             "gravity_mps2": cond.gravity_mps2, "dp_n": dp, "torque_nm": torque,
             "sinkage_m": sinkage, "resistance_n": torque / self.wheel.radius_m - dp,
-            "thrust_n": out["thrust_n"] + terms["grouser_thrust_n"],
+            "thrust_n": out["thrust_n"],
             "compaction_resistance_n": out["compaction_resistance_n"],
             "fz_n": out["fz_n"], "fz_residual_n": -residual,
             "converged": np.abs(residual) < CONVERGED_REL * cond.load_n,
