@@ -1,11 +1,17 @@
-"""Candidate explanations of the gap: soil-only recalibration, each missing effect, pairs.
+"""Candidate explanations of the gap: soil-only recalibration, each missing effect, pairs,
+each effect under each law of its family that the diagnosis may use.
 
 Each candidate frees a few well-posed parameters: three soil parameters (Bekker k_phi,
 friction angle, Janosi-Hanamoto K; Bekker 1969, Janosi & Hanamoto 1961) plus the strengths
 that each effect's law declares with their bounds (``fit`` of the law class, e.g. two for
-the default wheel flexibility: stiffness and hysteresis). A candidate uses the law the
-simulation model has for an effect, else the effect's default law (see
-``terramechanics.effects`` and docs/model-file.md).
+the Wong 2010 wheel flexibility: stiffness and hysteresis). The laws of an effect are
+those of ``terramechanics.effects.LAWS`` (docs/model-file.md), all of them unless the
+caller names a subset; an effect the simulation already has keeps the simulation's law.
+
+Pairs are fitted on a one-at-a-time design over laws (Saltelli et al. 2008, Global
+Sensitivity Analysis, ch. 2): every pair under the reference laws (each effect's law that
+scored best alone), and every pair with one of its effects switched to another law. The
+law robustness check (``sim_gap.laws``) then varies one effect's law at a time.
 """
 
 from __future__ import annotations
@@ -30,12 +36,27 @@ class Param:
 
 @dataclass(frozen=True)
 class Candidate:
+    """Effects (vocabulary order), the law of each (same order) and the free parameters."""
+
     effects: tuple[str, ...]
     params: tuple[Param, ...]
+    laws: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
+        """The effect set, e.g. ``grousers+slip_sinkage`` or ``soil_only``."""
         return "+".join(self.effects) if self.effects else "soil_only"
+
+    @property
+    def key(self) -> str:
+        """Effects with their laws, e.g. ``grousers(ding2011)+slip_sinkage(lyasko2010)``."""
+        return "+".join(f"{e}({law})" for e, law in zip(self.effects, self.laws)) \
+            if self.effects else "soil_only"
+
+    def law_values(self) -> dict[str, str]:
+        """``effects.<name>.law`` of each effect: switches the effect on under its law
+        (``WheelModel.with_parameters``), so it must come before the strengths."""
+        return {f"effects.{e}.law": law for e, law in zip(self.effects, self.laws)}
 
 
 def soil_params(model: tm.WheelModel) -> tuple[Param, ...]:
@@ -55,20 +76,59 @@ def effect_params(name: str, law: str | None = None) -> tuple[Param, ...]:
                  for p in tm.law_class(name, law).fit)
 
 
-def candidate(model: tm.WheelModel, effects: tuple[str, ...]) -> Candidate:
-    """Soil parameters and the strengths of ``effects`` (kept in the vocabulary's order)."""
+def allowed_laws(model: tm.WheelModel, effects: list[str],
+                 laws: dict[str, tuple[str, ...]] | None = None) -> dict[str, tuple[str, ...]]:
+    """Per effect, the laws a candidate may use: ``laws[effect]`` if given (each checked
+    against the family), else the simulation's law of an effect it has, else every law of
+    the family."""
+    laws = laws or {}
+    unknown = sorted(set(laws) - set(tm.LAWS))
+    if unknown:
+        raise KeyError(f"unknown effect(s) {unknown} in laws; known: {sorted(tm.LAWS)}")
+    out = {}
+    for e in effects:
+        if e in laws:
+            for law in laws[e]:
+                tm.law_class(e, law)  # a clear error for an unknown law
+            out[e] = tuple(laws[e])
+        elif e in model.effects:
+            out[e] = (model.effects[e].law,)
+        else:
+            out[e] = tuple(tm.LAWS[e])
+        if not out[e]:
+            raise ValueError(f"no law left for effect {e!r}")
+    return out
+
+
+def candidate(model: tm.WheelModel, effects: tuple[str, ...],
+              laws: dict[str, str] | None = None) -> Candidate:
+    """Soil parameters and the strengths of ``effects`` (vocabulary order) under ``laws``
+    (effect -> law; default: the simulation's law of an effect it has, else the default
+    law)."""
     effects = tuple(sorted(effects, key=list(tm.EFFECTS).index))
-    laws = {e: model.effects[e].law if e in model.effects else None for e in effects}
-    params = soil_params(model) + tuple(p for e in effects for p in effect_params(e, laws[e]))
-    return Candidate(tuple(effects), params)
+    laws = laws or {}
+    chosen = tuple(laws.get(e) or (model.effects[e].law if e in model.effects
+                                   else tm.DEFAULT_LAWS[e]) for e in effects)
+    params = soil_params(model) + tuple(p for e, law in zip(effects, chosen)
+                                        for p in effect_params(e, law))
+    return Candidate(effects, params, chosen)
 
 
-def singles(model: tm.WheelModel, effects: list[str]) -> list[Candidate]:
-    """Soil only, then each effect alone."""
-    return [candidate(model, ())] + [candidate(model, (e,)) for e in effects]
+def singles(model: tm.WheelModel, laws: dict[str, tuple[str, ...]]) -> list[Candidate]:
+    """Soil only, then each effect of ``laws`` alone under each of its laws."""
+    return [candidate(model, ())] + [candidate(model, (e,), {e: law})
+                                     for e, options in laws.items() for law in options]
 
 
-def pairs(model: tm.WheelModel, effects: list[str]) -> list[Candidate]:
-    """Every pair of ``effects`` (effects mask each other: a pair can win where neither
-    single does)."""
-    return [candidate(model, pair) for pair in combinations(effects, 2)]
+def pairs(model: tm.WheelModel, laws: dict[str, tuple[str, ...]],
+          reference: dict[str, str]) -> list[Candidate]:
+    """Every pair of the effects of ``laws`` (effects mask each other: a pair can win where
+    neither single does) under the ``reference`` laws, and with one of its two effects under
+    each of its other laws (one law changed at a time)."""
+    out = []
+    for a, b in combinations(laws, 2):
+        out.append(candidate(model, (a, b), {a: reference[a], b: reference[b]}))
+        for moved, kept in ((a, b), (b, a)):
+            out += [candidate(model, (a, b), {moved: law, kept: reference[kept]})
+                    for law in laws[moved] if law != reference[moved]]
+    return out

@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim_gap.crossval import CrossValidated
+from sim_gap.fit import strengths
 
 Z_TIE = 2.0
 #: a mean excess of log(1 + loss) below this is no practical difference (2 % of 1 + loss)
@@ -54,14 +55,16 @@ def rank(results: dict[str, CrossValidated], n_points: int) -> list[dict]:
     out = []
     for label in order:
         cv = results[label]
-        out.append({"label": label, "effects": list(cv.full.candidate.effects),
+        c = cv.full.candidate
+        out.append({"label": label, "effects": list(c.effects),
+                    "laws": dict(zip(c.effects, c.laws)),
                     "n_params": cv.full.n_params,
                     "held_out_score": float(np.sqrt(losses[label].mean())),
                     "held_out_loss": float(losses[label].mean()),
                     "z_vs_best": paired_z(losses[label], best) if label != order[0] else 0.0,
-                    "aicc": float(cv.full.aicc), "parameters": cv.full.values,
+                    "aicc": float(cv.full.aicc), "parameters": strengths(cv.full.values),
                     "held_out_run_losses": losses[label].tolist(),
-                    "fold_parameters": {name: v for name, _, _, v in cv.held_out}})
+                    "fold_parameters": {name: strengths(v) for name, _, _, v in cv.held_out}})
     return out
 
 

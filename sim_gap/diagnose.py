@@ -1,5 +1,6 @@
-"""One gap diagnosis: where (residual map), which (candidates, held-out ranking, verdict) and
-how far (held-out RMSE before and after). Pure: points and a simulation in, a dict out."""
+"""One gap diagnosis: where (residual map), which (candidates under each law of each
+effect, held-out ranking, a verdict that must hold under every law tried) and how far
+(held-out RMSE before and after). Pure: points and a simulation in, a dict out."""
 
 from __future__ import annotations
 
@@ -11,9 +12,10 @@ import pandas as pd
 
 from sim_gap import candidates as cands
 from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
-from sim_gap.decide import decide, rank
+from sim_gap.decide import rank
 from sim_gap.discriminate import separating_test
 from sim_gap.fit import quantities_of, sigmas
+from sim_gap.laws import reference_laws, robust_decide
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
 from sim_gap.simulated import Simulated
@@ -31,27 +33,33 @@ CONTRAST_NEEDED = {"multipass": "a second multipass level",
 @dataclass(frozen=True)
 class Settings:
     """``max_nfev``/``fold_nfev``: evaluations of a full / a fold fit; ``n_boot``: bootstrap
-    replicates; ``jobs``: worker processes for the candidate fits."""
+    replicates; ``jobs``: worker processes for the candidate fits; ``laws``: effect -> the
+    laws its candidates may use (default: every law of the family; see
+    ``sim_gap.candidates.allowed_laws``)."""
 
     max_nfev: int = 40
     fold_nfev: int = 12
     n_boot: int = 200
     jobs: int = 1
     seed: int = 0
+    laws: dict[str, tuple[str, ...]] | None = None
 
 
-def testable(sim: Simulated, points: pd.DataFrame, effects: list[str]
+def testable(sim: Simulated, points: pd.DataFrame, laws: dict[str, tuple[str, ...]]
              ) -> tuple[list[str], dict[str, str]]:
-    """Split ``effects`` into those that change a prediction at these conditions and the
-    others (with what the campaign would need)."""
+    """Split the effects of ``laws`` into those that change a prediction at these conditions
+    under one of their laws and the others (with what the campaign would need)."""
     sig = sigmas(points, sim.radius_m)
     base = sim.predict(points, {})
     keep, dropped = [], {}
-    for name in effects:
-        values = {p.name: p.start for p in cands.effect_params(name)}
-        pred = sim.predict(points, values)
-        change = max(float(np.nanmax(np.abs(pred[q] - base[q]) / sig[q]))
-                     for q in quantities_of(points))
+    for name, options in laws.items():
+        change = 0.0
+        for law in options:
+            values = {f"effects.{name}.law": law,
+                      **{p.name: p.start for p in cands.effect_params(name, law)}}
+            pred = sim.predict(points, values)
+            change = max([change] + [float(np.nanmax(np.abs(pred[q] - base[q]) / sig[q]))
+                                     for q in quantities_of(points)])
         if change >= TESTABLE_SIGMA:
             keep.append(name)
         else:
@@ -66,9 +74,10 @@ def _cv(args) -> CrossValidated:
 
 
 def _pair_start(c: cands.Candidate, singles: dict[str, CrossValidated]) -> dict[str, float]:
-    """Start of a pair's fit: the better single's fitted values plus the other effect's
-    fitted strength."""
-    fits = sorted((singles[e] for e in c.effects), key=lambda cv: cv.full.chi2)
+    """Start of a pair's fit: the better single's fitted values (same law) plus the other
+    effect's fitted strength."""
+    fits = sorted((singles[f"{e}({law})"] for e, law in zip(c.effects, c.laws)),
+                  key=lambda cv: cv.full.chi2)
     return {**fits[1].full.values, **fits[0].full.values}
 
 
@@ -81,7 +90,7 @@ def _run_all(sim, candidate_list, points, sig, settings, starts=None
             done = list(pool.map(_cv, jobs))
     else:
         done = [_cv(j) for j in jobs]
-    return {c.label: cv for c, cv in zip(candidate_list, done)}
+    return {c.key: cv for c, cv in zip(candidate_list, done)}
 
 
 def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = None,
@@ -90,32 +99,32 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     ``effects``: the candidate effects (default: every effect the simulation lacks)."""
     settings = settings or Settings()
     asked = [e for e in (effects or sim.missing_effects()) if e in sim.missing_effects()]
-    effects_ok, untestable = testable(sim, points, asked)
+    effects_ok, untestable = testable(sim, points,
+                                      cands.allowed_laws(sim.model, asked, settings.laws))
+    allowed = cands.allowed_laws(sim.model, effects_ok, settings.laws)
     sig = sigmas(points, sim.radius_m)
     n = len(points)
-    results = _run_all(sim, cands.singles(sim.model, effects_ok), points, sig, settings)
-    pairs = cands.pairs(sim.model, effects_ok)
+    results = _run_all(sim, cands.singles(sim.model, allowed), points, sig, settings)
+    reference = reference_laws(results, n)
+    pairs = cands.pairs(sim.model, allowed, reference)
     results.update(_run_all(sim, pairs, points, sig, settings,
                             [_pair_start(c, results) for c in pairs]))
-    ranked = rank(results, n)
-    losses = {label: cv.run_losses(n) for label, cv in results.items()}
-    decision = decide(ranked, losses)
+    decision = robust_decide(results, allowed, reference, n)
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
                                "out: " + ", ".join(sorted(untestable)))
     regions = residual_map(points, sim.predict(points, {}),
                            sim.predict(points, results["soil_only"].full.values), sim.radius_m)
-    if decision["verdict"] == "inconclusive" and decision["leaders"]:
-        a, b = (results[label].full.values for label in decision["leaders"])
+    if decision["verdict"] == "inconclusive" and len(decision["leaders"]) == 2:
+        a, b = (results[key].full.values for key in decision["leaders"])
         decision["separating_test"] = separating_test(sim, points, a, b)
     elif decision["verdict"] == "inconclusive":
         decision["separating_test"] = largest_gap(regions)
-    after_label = decision["chosen"]
     return {
-        "verdict": decision["verdict"], "decision": decision, "candidates": ranked,
+        "verdict": decision["verdict"], "decision": decision, "candidates": rank(results, n),
         "untestable_effects": untestable, "contrasts": contrasts(points),
         "folds": [name for name, _ in folds(points)],
-        "shrink": shrink(sim, points, results["soil_only"], results[after_label],
+        "shrink": shrink(sim, points, results["soil_only"], results[decision["chosen"]],
                          settings.n_boot, settings.seed),
         "regions": regions,
         "n_points": n, "quantities": quantities_of(points),

@@ -46,18 +46,27 @@ def standardised_residuals(points: pd.DataFrame, predicted: dict[str, np.ndarray
     return np.column_stack(cols)
 
 
-def to_values(c: Candidate, u: np.ndarray) -> dict[str, float]:
-    return {p.name: float(np.exp(x) if p.log else x) for p, x in zip(c.params, u)}
+def to_values(c: Candidate, u: np.ndarray) -> dict[str, float | str]:
+    """The model values of ``c`` at internal ``u``: its laws first, then the parameters."""
+    return {**c.law_values(),
+            **{p.name: float(np.exp(x) if p.log else x) for p, x in zip(c.params, u)}}
 
 
-def to_internal(c: Candidate, values: dict[str, float]) -> np.ndarray:
-    return np.array([np.log(values[p.name]) if p.log else values[p.name] for p in c.params])
+def strengths(values: dict[str, float | str]) -> dict[str, float]:
+    """The fitted numbers of model ``values`` (without the laws)."""
+    return {k: v for k, v in values.items() if not isinstance(v, str)}
+
+
+def to_internal(c: Candidate, values: dict[str, float | str]) -> np.ndarray:
+    """Internal coordinates of ``values`` (a parameter they lack: its start value)."""
+    x = [values.get(p.name, p.start) for p in c.params]
+    return np.array([np.log(v) if p.log else v for p, v in zip(c.params, x)])
 
 
 @dataclass(frozen=True)
 class FitResult:
     candidate: Candidate
-    values: dict[str, float]
+    values: dict[str, float | str]  # laws and fitted parameters (see ``to_values``)
     chi2: float
     n_residuals: int
 

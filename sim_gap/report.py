@@ -25,9 +25,10 @@ def build_report(diagnosis: dict, measured_source: str, sim_source: str,
         "reason": diagnosis["decision"]["reason"],
         "separating_test": diagnosis["decision"].get("separating_test"),
         "chosen": diagnosis["decision"]["chosen"],
-        "candidates": [{k: c[k] for k in ("label", "effects", "held_out_score", "held_out_loss",
-                                          "z_vs_best", "n_params", "aicc", "parameters",
-                                          "fold_parameters", "held_out_run_losses")}
+        "candidates": [{k: c[k] for k in ("label", "effects", "laws", "held_out_score",
+                                          "held_out_loss", "z_vs_best", "n_params", "aicc",
+                                          "parameters", "fold_parameters",
+                                          "held_out_run_losses")}
                        for c in diagnosis["candidates"]],
         "held_out_rmse_before": shrink["held_out_rmse_before"],
         "held_out_rmse_after": shrink["held_out_rmse_after"],

@@ -26,12 +26,31 @@ def register(sub: argparse._SubParsersAction) -> None:
                                              "WPM-CSV simulation (default: bb2_sand, no effects)")
     p.add_argument("--effects", help="comma-separated candidate effects (default: all the "
                                      "simulation lacks)")
+    p.add_argument("--laws", help="laws the candidates may use, comma-separated effect=law "
+                                  "(repeat an effect for several), e.g. grousers=ding2011,"
+                                  "slip_sinkage=lyasko2010 (default: every law of each effect; "
+                                  "docs/gap-report.md)")
     p.add_argument("--json", help="write the report JSON here")
     p.add_argument("--html", help="write the HTML report here")
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
     p.add_argument("--boot", type=int, default=200, help="bootstrap replicates (default 200)")
     p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
     p.set_defaults(func=run)
+
+
+def parse_laws(text: str) -> dict[str, tuple[str, ...]]:
+    """``grousers=ding2011,grousers=bekker1956,slip_sinkage=lyasko2010`` -> effect -> laws,
+    each checked against terramechanics.LAWS."""
+    import terramechanics as tm
+
+    out: dict[str, tuple[str, ...]] = {}
+    for item in (t.strip() for t in text.split(",") if t.strip()):
+        effect, sep, law = (x.strip() for x in item.partition("="))
+        if not sep or not law:
+            raise ValueError(f"{item!r} is not effect=law")
+        tm.law_class(effect, law)
+        out[effect] = out.get(effect, ()) + (law,)
+    return out
 
 
 def run(args: argparse.Namespace) -> int:
@@ -48,9 +67,14 @@ def run(args: argparse.Namespace) -> int:
                   file=sys.stderr)
             return exit_codes.USAGE
     try:
+        laws = parse_laws(args.laws) if args.laws else None
+    except (KeyError, ValueError) as exc:
+        print(f"swtlab gap: --laws: {exc}", file=sys.stderr)
+        return exit_codes.USAGE
+    try:
         report = run_gap(args.measured, args.sim, args.json, args.html, effects,
                          args.reference_model,
-                         Settings(n_boot=args.boot, jobs=args.jobs, seed=args.seed))
+                         Settings(n_boot=args.boot, jobs=args.jobs, seed=args.seed, laws=laws))
     except (OSError, ValueError, KeyError) as exc:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT

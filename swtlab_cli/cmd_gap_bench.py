@@ -25,6 +25,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--boot", type=int, default=50, help="bootstrap replicates per diagnosis")
     p.add_argument("--fast", action="store_true",
                    help="small campaigns (2 loads x 3 slips x 2 multipass x 2 gravity)")
+    p.add_argument("--truth-laws", choices=("in-family", "held-out"), default="in-family",
+                   help="in-family: the diagnosis may use every law of each effect; held-out: "
+                        "the law that made each campaign's truth is removed from the laws "
+                        "it may use, for every effect (one law of each family left out in "
+                        "turn)")
+    p.add_argument("--signal-model", choices=("testbed", "second"), default="testbed",
+                   help="raw-run generator: the virtual testbed, or the second rig written "
+                        "apart from it (validation.second_rig)")
     p.add_argument("--json", type=Path, help="write the score JSON here")
     p.set_defaults(func=run)
 
@@ -38,7 +46,12 @@ def run(args: argparse.Namespace) -> int:
     design = FAST_DESIGN if args.fast else Design()
     with tempfile.TemporaryDirectory(prefix="gap-bench-") as tmp:
         workdir = args.workdir or Path(tmp)
-        result = run_bench(args.n, args.seed, workdir, design, args.jobs, args.boot)
+        try:
+            result = run_bench(args.n, args.seed, workdir, design, args.jobs, args.boot,
+                               args.truth_laws, args.signal_model)
+        except ValueError as exc:
+            print(f"swtlab gap-bench: {exc}")
+            return exit_codes.BAD_INPUT
     print(format_score(result))
     t = result["timing_s"]
     print(f"time: generate {t['generate']:.0f} s, process + diagnose "

@@ -12,6 +12,7 @@ from sim_gap import candidates
 from sim_gap.decide import decide, rank
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.discriminate import separating_test
+from sim_gap.laws import assignments, reference_laws, robust_decide
 from sim_gap.simulated import Simulated
 
 BASE = tm.shipped_model("bb2_sand").with_effects(**{n: False for n in tm.EFFECTS})
@@ -98,18 +99,20 @@ def test_separating_test_asks_for_the_missing_contrast():
 
 
 def _fake(labels_losses: dict[str, np.ndarray]):
-    """rank/decide inputs without fits: a stand-in for CrossValidated."""
+    """rank/decide inputs without fits: a stand-in for CrossValidated. A key is an effect
+    set (``grousers+slip_sinkage``) or effects with their laws (``grousers(ding2011)``)."""
 
     class Fit:
-        def __init__(self, label, n_params):
-            self.candidate = type("C", (), {"effects": () if label == "soil_only"
-                                            else tuple(label.split("+"))})()
-            self.n_params, self.aicc, self.values = n_params, 0.0, {}
+        def __init__(self, key):
+            parts = [] if key == "soil_only" else key.split("+")
+            effects = tuple(p.split("(")[0] for p in parts)
+            laws = tuple(p.split("(")[1].rstrip(")") if "(" in p else "law" for p in parts)
+            self.candidate = candidates.Candidate(effects, (), laws)
+            self.n_params, self.aicc, self.values = 3 + len(parts), 0.0, {}
 
     class CV:
-        def __init__(self, label, losses):
-            self.full, self.losses, self.held_out = Fit(label, 3 + label.count("+") + 1), \
-                losses, []
+        def __init__(self, key, losses):
+            self.full, self.losses, self.held_out = Fit(key), losses, []
 
         def run_losses(self, n):
             return self.losses
@@ -159,3 +162,57 @@ def test_candidates_free_the_fit_parameters_their_law_declares():
         ("effects.wheel_flexibility.ground_pressure_pa", 2e3, 5e5, True)]
     for p in candidates.candidate(lugged, ("grousers",)).params[3:]:  # the names resolve
         lugged.with_parameters({p.name: p.start})
+
+
+def test_a_call_that_holds_under_one_law_only_is_inconclusive_naming_the_law():
+    """slip_sinkage wins clearly under its ding2011 law; under lyasko2010 it fits badly
+    and grousers wins: the verdict depends on the law's shape."""
+    rng = np.random.default_rng(3)
+    noise = lambda: rng.normal(0, 0.05, 30)  # noqa: E731
+    losses = {"soil_only": 8 + noise(), "grousers(bekker1956)": 3 + noise(),
+              "slip_sinkage(ding2011)": 1 + noise(), "slip_sinkage(lyasko2010)": 5 + noise(),
+              "grousers(bekker1956)+slip_sinkage(ding2011)": 1 + noise(),
+              "grousers(bekker1956)+slip_sinkage(lyasko2010)": 3 + noise()}
+    allowed = {"grousers": ("bekker1956",), "slip_sinkage": ("ding2011", "lyasko2010")}
+    results = _fake(losses)
+    reference = reference_laws(results, 30)
+    assert reference == {"grousers": "bekker1956", "slip_sinkage": "ding2011"}
+    out = robust_decide(results, allowed, reference, 30)
+    assert out["verdict"] == "inconclusive" and out["law_dependent"]
+    assert out["law_sensitivity"]["disagreeing"] == [
+        {"effect": "slip_sinkage", "law": "lyasko2010", "verdict": ["grousers"],
+         "chosen": "grousers(bekker1956)"}]
+    assert out["leaders"] == ["slip_sinkage(ding2011)", "grousers(bekker1956)"]
+    assert "with slip_sinkage under lyasko2010 it is grousers" in out["reason"]
+    # both laws explain the data far better than grousers: a confident, law-robust call
+    losses["slip_sinkage(lyasko2010)"] = 1.1 + noise()
+    losses["grousers(bekker1956)+slip_sinkage(lyasko2010)"] = 1.1 + noise()
+    out = robust_decide(_fake(losses), allowed, reference, 30)
+    assert out["verdict"] == ["slip_sinkage"] and out["chosen"] == "slip_sinkage(ding2011)"
+    sens = out["law_sensitivity"]
+    assert sens["robust"] and [a["verdict"] for a in sens["assignments"]] == [
+        ["slip_sinkage"], ["slip_sinkage"]]
+
+
+def test_pairs_vary_one_law_at_a_time():
+    allowed = {"grousers": ("bekker1956", "ding2011"), "slip_sinkage": ("ding2011", "lyasko2010"),
+               "bulldozing": ("bekker1969",)}
+    reference = {"grousers": "ding2011", "slip_sinkage": "ding2011", "bulldozing": "bekker1969"}
+    assert [c.key for c in candidates.singles(BASE, allowed)] == [
+        "soil_only", "grousers(bekker1956)", "grousers(ding2011)", "slip_sinkage(ding2011)",
+        "slip_sinkage(lyasko2010)", "bulldozing(bekker1969)"]
+    assert [c.key for c in candidates.pairs(BASE, allowed, reference)] == [
+        "grousers(ding2011)+slip_sinkage(ding2011)", "grousers(bekker1956)+slip_sinkage(ding2011)",
+        "grousers(ding2011)+slip_sinkage(lyasko2010)",
+        "grousers(ding2011)+bulldozing(bekker1969)", "grousers(bekker1956)+bulldozing(bekker1969)",
+        "slip_sinkage(ding2011)+bulldozing(bekker1969)",
+        "slip_sinkage(lyasko2010)+bulldozing(bekker1969)"]
+    assert assignments(allowed, reference) == [
+        reference, {**reference, "grousers": "bekker1956"},
+        {**reference, "slip_sinkage": "lyasko2010"}]
+    lyasko = candidates.candidate(BASE, ("slip_sinkage",), {"slip_sinkage": "lyasko2010"})
+    model = BASE.with_parameters({**lyasko.law_values(), "effects.slip_sinkage.coefficient": 0.5})
+    assert model.effects["slip_sinkage"].law == "lyasko2010"
+    assert model.effects["slip_sinkage"].coefficient == 0.5
+    with pytest.raises(KeyError, match="unknown law 'x' of effect 'grousers'"):
+        candidates.allowed_laws(BASE, ["grousers"], {"grousers": ("x",)})

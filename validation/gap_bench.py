@@ -5,13 +5,24 @@ Layout of the work folder::
 
     sim.toml                      the simulation given to every diagnosis (base model)
     c000/campaign/...             raw runs of campaign 0 (all a diagnosis can read)
+    c000/laws.txt                 the laws the diagnosis may use (``swtlab gap --laws``)
     c000/swtlab.sqlite            `swtlab process` output
     c000/gap.json                 `swtlab gap` report
-    labels/labels.json            hidden effect sets and strengths (only the scorer reads it)
-    labels/c000/truth/...         the testbed's per-run truth, moved out of the campaign
+    labels/labels.json            hidden effect sets, laws and strengths (only the scorer)
+    labels/c000/truth/...         the signal model's per-run truth, moved out of the campaign
 
 Each campaign: loads x slips x multipass {0, 1} x gravity {9.81, 3.71}, so that every effect
 has the contrast it needs (docs/gap-report.md, "Identifiability").
+
+Laws of the truth (``truth_laws``): campaign i makes each of its effects with law
+``i mod n`` of the effect's family (``terramechanics.LAWS``, sorted by name), the same in
+both modes, so the two modes see the same raw data. ``in-family``: the diagnosis may use
+every law. ``held-out``: that law is removed, for every family (not only the truth's
+effects, which would give them away), and the diagnosis gets the remaining laws.
+
+Signal models (``signal_model``): ``testbed`` (``virtual_testbed``) or ``second``
+(``validation.second_rig``, written apart from the testbed: other transients, noise,
+drift), through :func:`write_second_rig`.
 """
 
 from __future__ import annotations
@@ -32,16 +43,31 @@ from sim_gap.vocabulary import EFFECT_NAMES
 
 STANDARD_GRAVITY_MPS2 = 9.80665
 MARS_GRAVITY_MPS2 = 3.71
-#: hidden effect strengths are drawn uniformly in these ranges
+TRUTH_LAWS = ("in-family", "held-out")
+SIGNAL_MODELS = ("testbed", "second")
+#: hidden effect strengths, per law, drawn uniformly in these ranges; the ranges of the
+#: second law of each family give about the same RMS standardised change over the bench
+#: design as the first law's (0.8-2 sigma for multipass up to 5-14 for slip-sinkage), but
+#: Rankine bulldozing, far weaker than Bekker's, stays near its formula (x 2-5: 1.3-3 sigma)
 STRENGTHS = {
-    "grousers": {"shear_radius_factor": (0.3, 1.0)},
-    "slip_sinkage": {"n1": (0.3, 0.8)},
-    "reduced_gravity": {"bearing_exponent": (0.6, 1.5)},
-    "wheel_flexibility": {"radial_stiffness_n_m": (15e3, 60e3),
-                          "hysteresis_coefficient": (0.015, 0.04)},
-    "multipass": {"stiffness_gain_per_pass": (0.15, 0.5)},
-    "bulldozing": {"coefficient": (0.05, 0.5)},
+    "grousers": {"bekker1956": {"shear_radius_factor": (0.3, 1.0)},
+                 "ding2011": {"shear_radius_factor": (0.3, 1.0),
+                              "lug_sinkage_gain": (1.0, 4.0)}},
+    "slip_sinkage": {"ding2011": {"n1": (0.3, 0.8)},
+                     "lyasko2010": {"coefficient": (0.4, 1.0)}},
+    "reduced_gravity": {"wong_kobayashi2012": {"bearing_exponent": (0.6, 1.5)},
+                        "reece1965": {"bearing_exponent": (0.6, 1.5)}},
+    "wheel_flexibility": {"wong2010": {"radial_stiffness_n_m": (15e3, 60e3),
+                                       "hysteresis_coefficient": (0.015, 0.04)},
+                          "bekker1969": {"ground_pressure_pa": (15e3, 35e3)}},
+    "multipass": {"wong2010": {"stiffness_gain_per_pass": (0.15, 0.5)},
+                  # K_e as a multiple of the truth's k_phi (SCM needs K_e > k_phi)
+                  "krenn_hirzinger2009": {"elastic_stiffness_pa_m": (1.2, 1.7)}},
+    "bulldozing": {"bekker1969": {"coefficient": (0.05, 0.5)},
+                   "rankine_terzaghi1943": {"coefficient": (2.0, 5.0)}},
 }
+#: strengths drawn as a multiple of the truth soil's k_phi
+KPHI_RELATIVE = {("multipass", "krenn_hirzinger2009"): "elastic_stiffness_pa_m"}
 
 
 @dataclass(frozen=True)
@@ -64,20 +90,44 @@ def base_model() -> tm.WheelModel:
     return model.with_effects(**{name: False for name in tm.EFFECTS})
 
 
-def draw_truth(rng: np.random.Generator) -> tuple[tm.WheelModel, dict]:
+def truth_law(campaign: int, effect: str) -> str:
+    """The law campaign ``campaign`` makes ``effect`` with (and, held out, removes)."""
+    laws = sorted(tm.LAWS[effect])
+    return laws[campaign % len(laws)]
+
+
+def diagnosis_laws(campaign: int, truth_laws: str) -> dict[str, tuple[str, ...]] | None:
+    """The laws the diagnosis of campaign ``campaign`` may use: all (``None``) in family;
+    held out, every family without the law of :func:`truth_law`."""
+    if truth_laws not in TRUTH_LAWS:
+        raise ValueError(f"truth_laws must be one of {TRUTH_LAWS}, not {truth_laws!r}")
+    if truth_laws == "in-family":
+        return None
+    return {e: tuple(law for law in sorted(tm.LAWS[e]) if law != truth_law(campaign, e))
+            for e in EFFECT_NAMES}
+
+
+def draw_truth(rng: np.random.Generator, campaign: int = 0) -> tuple[tm.WheelModel, dict]:
     """A hidden truth: soil perturbed (k_phi x lognormal 25 %, friction angle +-1.5 deg
-    normal, K x lognormal 20 %) and none, one or two effects (a third each) at random
-    strengths. Returns the model and its label."""
+    normal, K x lognormal 20 %) and none, one or two effects (a third each), each under its
+    law of :func:`truth_law`, at random strengths. Returns the model and its label."""
     n_effects = int(rng.integers(0, 3))
     effects = sorted(rng.choice(EFFECT_NAMES, size=n_effects, replace=False).tolist(),
                      key=EFFECT_NAMES.index)
-    params = {e: {k: float(rng.uniform(*r)) for k, r in STRENGTHS[e].items()} for e in effects}
     soil = base_model().soil
     soil_values = {"kphi": soil.kphi * float(np.exp(rng.normal(0, 0.25))),
                    "friction_angle_deg": soil.friction_angle_deg + float(rng.normal(0, 1.5)),
                    "shear_modulus_m": soil.shear_modulus_m * float(np.exp(rng.normal(0, 0.2)))}
-    model = base_model().with_soil(**soil_values).with_effects(**params)
-    return model, {"effects": effects, "parameters": params, "soil": soil_values}
+    laws = {e: truth_law(campaign, e) for e in effects}
+    params = {}
+    for e in effects:
+        params[e] = {k: float(rng.uniform(*r)) for k, r in STRENGTHS[e][laws[e]].items()}
+        scaled = KPHI_RELATIVE.get((e, laws[e]))
+        if scaled:
+            params[e][scaled] *= soil_values["kphi"]
+    model = base_model().with_soil(**soil_values).with_effects(
+        **{e: {"law": laws[e], **params[e]} for e in effects})
+    return model, {"effects": effects, "laws": laws, "parameters": params, "soil": soil_values}
 
 
 def conditions(design: Design):
@@ -93,46 +143,93 @@ def conditions(design: Design):
     return out
 
 
+def write_second_rig(out: Path, conds, truth: tm.WheelModel, seed: int, name: str) -> None:
+    """The hook to the second signal model: ``validation.second_rig.write_campaign`` with
+    the bench's conditions and the truth model as its truth function (its raw runs under
+    ``out/campaign``, its truth under ``out/truth``, like the testbed's)."""
+    try:
+        from validation import second_rig
+    except ImportError as exc:
+        raise ValueError("signal model 'second' needs validation.second_rig "
+                         "(branch second)") from exc
+    w = truth.wheel
+    wheel = second_rig.WheelGeometry(name="bench_wheel", radius_m=w.radius_m,
+                                     width_m=w.width_m, grouser_count=w.grouser_count,
+                                     grouser_height_m=w.grouser_height_m)
+    runs = [second_rig.RunCondition(c.run_id, "speed_control", c.load_n,
+                                    slip_setpoint=c.slip_setpoint, multipass=c.multipass,
+                                    gravity_mps2=c.gravity_mps2, campaign=name, wheel=wheel)
+            for c in conds]
+    law = tm.ModelLaw(truth)
+
+    def truth_fn(c) -> dict[str, float]:
+        v = law.evaluate(c.load_n, c.slip_setpoint, c.multipass, c.gravity_mps2)
+        return {"slip": c.slip_setpoint, "travel_velocity_mps": c.velocity_mps,
+                "wheel_load_n": c.load_n, **{q: float(v[q]) for q in
+                                             ("dp_n", "torque_nm", "sinkage_m")}}
+
+    second_rig.write_campaign(out, runs, truth_fn, seed)
+
+
 def _generate(job) -> None:
     """One campaign's raw runs; its truth folder is moved out of the campaign."""
     from virtual_testbed import Testbed, generate_campaign
 
-    workdir, name, truth, seed, design = job
+    workdir, name, truth, seed, design, signal_model = job
     out = workdir / name
-    generate_campaign(out, conditions(design), seed=seed, duration_s=design.duration_s,
-                      testbed=Testbed(law=tm.ModelLaw(truth), campaign=name))
+    if signal_model == "second":
+        write_second_rig(out, conditions(design), truth, seed, name)
+    else:
+        generate_campaign(out, conditions(design), seed=seed, duration_s=design.duration_s,
+                          testbed=Testbed(law=tm.ModelLaw(truth), campaign=name))
     (workdir / "labels" / name).mkdir(parents=True, exist_ok=True)
     shutil.move(str(out / "truth"), str(workdir / "labels" / name / "truth"))
 
 
+def laws_option(laws: dict[str, tuple[str, ...]] | None) -> str:
+    """``swtlab gap --laws`` text of ``laws`` (empty: every law)."""
+    return ",".join(f"{e}={law}" for e, options in (laws or {}).items() for law in options)
+
+
 def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
-                   workers: int = 2) -> Path:
-    """Write ``n`` campaigns and the labels file; return the labels path."""
+                   workers: int = 2, truth_laws: str = "in-family",
+                   signal_model: str = "testbed") -> Path:
+    """Write ``n`` campaigns, the laws each diagnosis may use and the labels file; return
+    the labels path."""
+    if signal_model not in SIGNAL_MODELS:
+        raise ValueError(f"signal_model must be one of {SIGNAL_MODELS}, not {signal_model!r}")
     workdir.mkdir(parents=True, exist_ok=True)
     tm.save_model(base_model(), workdir / "sim.toml")
     rng = np.random.default_rng(seed)
-    truths = [draw_truth(rng) for _ in range(n)]
-    jobs = [(workdir, f"c{i:03d}", truth, seed * 1000 + i, design)
+    truths = [draw_truth(rng, i) for i in range(n)]
+    jobs = [(workdir, f"c{i:03d}", truth, seed * 1000 + i, design, signal_model)
             for i, (truth, _) in enumerate(truths)]
     with ProcessPoolExecutor(workers) as pool:
         list(pool.map(_generate, jobs))
-    labels = {f"c{i:03d}": label for i, (_, label) in enumerate(truths)}
+    for i in range(n):
+        (workdir / f"c{i:03d}" / "laws.txt").write_text(
+            laws_option(diagnosis_laws(i, truth_laws)) + "\n")
+    labels = {f"c{i:03d}": {**label, "truth_laws": truth_laws, "signal_model": signal_model}
+              for i, (_, label) in enumerate(truths)}
     path = workdir / "labels" / "labels.json"
     path.write_text(json.dumps(labels, indent=1) + "\n")
     return path
 
 
-def diagnose_campaign(workdir: Path, name: str, boot: int) -> float:
-    """``swtlab process`` then ``swtlab gap`` in separate processes that are given the raw
-    campaign folder, the database and the simulation only. Returns the seconds taken."""
+def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True) -> float:
+    """``swtlab process`` (unless ``process`` is False: the database is there) then
+    ``swtlab gap`` in separate processes that are given the raw campaign folder, the
+    database, the simulation and the laws they may use only. Returns the seconds taken."""
     start = time.perf_counter()
     db = f"sqlite:///{workdir / name / 'swtlab.sqlite'}"
     cli = [sys.executable, "-m", "swtlab_cli.main"]
-    subprocess.run(cli + ["process", str(workdir / name / "campaign"), "--db", db, "--quiet"],
-                   check=True, capture_output=True)
+    if process:
+        subprocess.run(cli + ["process", str(workdir / name / "campaign"), "--db", db,
+                              "--quiet"], check=True, capture_output=True)
+    laws = (workdir / name / "laws.txt").read_text().strip()
     subprocess.run(cli + ["gap", "--measured", db, "--sim", str(workdir / "sim.toml"),
-                          "--json", str(workdir / name / "gap.json"), "--boot", str(boot)],
-                   check=True, capture_output=True)
+                          "--json", str(workdir / name / "gap.json"), "--boot", str(boot)]
+                   + (["--laws", laws] if laws else []), check=True, capture_output=True)
     return time.perf_counter() - start
 
 
@@ -152,7 +249,10 @@ def score(labels_path: Path, workdir: Path) -> dict:
         hidden = label["effects"]
         called = None if verdict == "inconclusive" else sorted(verdict, key=EFFECT_NAMES.index)
         shrink = report["shrink_pct"]
-        rows.append({"campaign": name, "hidden": hidden, "called": called,
+        rows.append({"campaign": name, "hidden": hidden, "hidden_laws": label["laws"],
+                     "allowed_laws": (workdir / name / "laws.txt").read_text().strip(),
+                     "law_dependent": bool(report["decision"].get("law_dependent")),
+                     "called": called,
                      "class": ("none", "single", "pair")[len(hidden)],
                      "exact": called == hidden,
                      "confident_wrong": called is not None and called != hidden,
@@ -182,6 +282,7 @@ def score(labels_path: Path, workdir: Path) -> dict:
         "exact_share": sum(r["exact"] for r in rows) / max(len(rows), 1),
         "inconclusive_share": sum(r["called"] is None for r in rows) / max(len(rows), 1),
         "confident_wrong_share": sum(r["confident_wrong"] for r in rows) / max(len(rows), 1),
+        "law_dependent": sum(r["law_dependent"] for r in rows),
         "mean_shrink_pct": float(np.mean([r["mean_shrink_pct"] for r in effect_rows]))
         if effect_rows else None,
         "campaigns": rows})
@@ -189,14 +290,15 @@ def score(labels_path: Path, workdir: Path) -> dict:
 
 
 def format_score(s: dict) -> str:
-    lines = [f"campaigns: {s['n']}"]
+    lines = [f"campaigns: {s['n']} (truth laws {s.get('truth_laws', 'in-family')})"]
     for cls, v in s["by_class"].items():
         share = "n/a" if v["exact_share"] is None else f"{100 * v['exact_share']:.0f} %"
         lines.append(f"  {cls:6s} n={v['n']:3d} exact {share:>6s}  inconclusive "
                      f"{v['inconclusive']}  confident-wrong {v['confident_wrong']}")
     lines.append(f"exact-set accuracy {100 * s['exact_share']:.0f} %, inconclusive "
                  f"{100 * s['inconclusive_share']:.0f} %, confident wrong "
-                 f"{100 * s['confident_wrong_share']:.0f} %")
+                 f"{100 * s['confident_wrong_share']:.0f} %; inconclusive because the call "
+                 f"depended on a law: {s['law_dependent']}")
     shrink = s["mean_shrink_pct"]
     lines.append("mean shrink (confident effect calls): "
                  + ("n/a" if shrink is None else f"{shrink:.1f} %"))
@@ -212,17 +314,36 @@ def format_score(s: dict) -> str:
 
 
 def run_bench(n: int, seed: int, workdir: Path, design: Design = Design(), jobs: int = 2,
-              boot: int = 50) -> dict:
+              boot: int = 50, truth_laws: str = "in-family", signal_model: str = "testbed"
+              ) -> dict:
     """Generate, diagnose (``jobs`` campaigns at a time, each in its own processes), score."""
     t0 = time.perf_counter()
-    labels = make_campaigns(n, seed, workdir, design, jobs)
+    labels = make_campaigns(n, seed, workdir, design, jobs, truth_laws, signal_model)
+    t1 = time.perf_counter()
+    return _diagnose_and_score(labels, workdir, n, jobs, boot, True, truth_laws, t1 - t0)
+
+
+def rediagnose(workdir: Path, truth_laws: str, jobs: int = 2, boot: int = 50) -> dict:
+    """Diagnose the processed campaigns of ``workdir`` again under the other ``truth_laws``
+    mode (same raw data, same truths: only the laws given to the diagnosis change), score."""
+    labels = workdir / "labels" / "labels.json"
+    n = len(json.loads(labels.read_text()))
+    for i in range(n):
+        (workdir / f"c{i:03d}" / "laws.txt").write_text(
+            laws_option(diagnosis_laws(i, truth_laws)) + "\n")
+    return _diagnose_and_score(labels, workdir, n, jobs, boot, False, truth_laws, 0.0)
+
+
+def _diagnose_and_score(labels: Path, workdir: Path, n: int, jobs: int, boot: int,
+                        process: bool, truth_laws: str, generate_s: float) -> dict:
     t1 = time.perf_counter()
     names = [f"c{i:03d}" for i in range(n)]
     with ThreadPoolExecutor(jobs) as pool:
-        seconds = list(pool.map(lambda name: diagnose_campaign(workdir, name, boot), names))
+        seconds = list(pool.map(lambda name: diagnose_campaign(workdir, name, boot, process),
+                                names))
     t2 = time.perf_counter()
-    out = score(labels, workdir)
-    out["timing_s"] = {"generate": t1 - t0, "process_and_diagnose": t2 - t1,
+    out = {**score(labels, workdir), "truth_laws": truth_laws}
+    out["timing_s"] = {"generate": generate_s, "process_and_diagnose": t2 - t1,
                        "per_campaign_mean": float(np.mean(seconds)), "jobs": jobs}
-    (workdir / "score.json").write_text(json.dumps(out, indent=1) + "\n")
+    (workdir / f"score-{truth_laws}.json").write_text(json.dumps(out, indent=1) + "\n")
     return out
