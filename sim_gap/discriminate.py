@@ -21,14 +21,21 @@ def _grid(loads, slips, multipass, gravity) -> pd.DataFrame:
                          "multipass": m.ravel().astype(int), "gravity_mps2": g.ravel()})
 
 
-def proposals(points: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
-    """Extra tests a lab can run, each as the points it would measure."""
+#: the wheel of the "smooth wheel" proposal (grousers removed, same rim)
+SMOOTH_WHEEL = {"wheel.grouser_count": 0, "wheel.grouser_height_m": 0.0}
+
+
+def proposals(points: pd.DataFrame, grousered: bool = False
+              ) -> list[tuple[str, pd.DataFrame, dict[str, float]]]:
+    """Extra tests a lab can run, each as the points it would measure and the change of
+    wheel it needs (a smooth wheel, for a ``grousered`` one, tells lug effects from soil
+    effects)."""
     loads = np.unique(points["load_set_n"])
     mps = np.unique(points["multipass"])
     gs = np.unique(points["gravity_mps2"].round(4))
     slips = np.array([0.1, 0.3, 0.5])
     other_g = [g for g in PROPOSED_GRAVITY_MPS2 if not np.any(np.isclose(gs, g, atol=0.05))][0]
-    return [
+    out = [
         (f"add a load ({1.6 * loads.max():.0f} N and {0.5 * loads.min():.0f} N)",
          _grid([0.5 * loads.min(), 1.6 * loads.max()], slips, mps[:1], gs[:1])),
         (f"run multipass level {mps.max() + 1}", _grid(loads, slips, [mps.max() + 1], gs[:1])),
@@ -37,6 +44,11 @@ def proposals(points: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
         ("more slips above 0.5 (0.6, 0.75, 0.9)", _grid(loads, [0.6, 0.75, 0.9], mps[:1], gs[:1])),
         ("add skid (braked) slips (-0.5, -0.2)", _grid(loads, [-0.5, -0.2], mps[:1], gs[:1])),
     ]
+    out = [(text, grid, {}) for text, grid in out]
+    if grousered:
+        out.append(("run a smooth wheel (same rim, no grousers) on the same soil at these "
+                    "loads and slips", _grid(loads, slips, mps[:1], gs[:1]), SMOOTH_WHEEL))
+    return out
 
 
 def separating_test(sim: Simulated, points: pd.DataFrame, values_a: dict[str, float],
@@ -44,8 +56,10 @@ def separating_test(sim: Simulated, points: pd.DataFrame, values_a: dict[str, fl
     """The proposal with the largest standardised difference between the two fits."""
     quantities = quantities_of(points)
     best = {"test": None, "separation_sigma": 0.0}
-    for text, grid in proposals(points):
-        a, b = sim.predict(grid, values_a), sim.predict(grid, values_b)
+    wheel = sim.model.wheel
+    for text, grid, change in proposals(points, wheel.grouser_count > 0
+                                        and wheel.grouser_height_m > 0):
+        a, b = sim.predict(grid, {**values_a, **change}), sim.predict(grid, {**values_b, **change})
         load = grid["load_n"].to_numpy(float)
         sep = max(float(np.nanmax(np.abs(a[q] - b[q]) / model_error_floor(q, load, sim.radius_m)))
                   for q in quantities)

@@ -17,6 +17,8 @@ from sim_gap.simulated import Simulated
 
 BASE = tm.shipped_model("bb2_sand").with_effects(**{n: False for n in tm.EFFECTS})
 FAST = Settings(max_nfev=25, fold_nfev=8, n_boot=20)
+DEFAULT_LAWS = Settings(max_nfev=25, fold_nfev=8, n_boot=20,
+                        laws={e: (law,) for e, law in tm.DEFAULT_LAWS.items()})
 
 
 def synthetic_points(truth: tm.WheelModel, seed: int = 0, loads=(80.0, 180.0, 300.0),
@@ -49,14 +51,18 @@ CANDIDATES = ["grousers", "slip_sinkage", "bulldozing"]
     ({"bulldozing": {"coefficient": 1.5}}, ["bulldozing"]),
 ])
 def test_injected_effect_is_found(effects, expected):
+    """Under the default laws (the truth's): a law-robust call, as only one law is tried."""
     truth = BASE.with_soil(**TRUTH_SOIL).with_effects(**effects)
-    report = diagnose(synthetic_points(truth), Simulated(BASE), CANDIDATES, FAST)
+    report = diagnose(synthetic_points(truth), Simulated(BASE), CANDIDATES, DEFAULT_LAWS)
     assert report["verdict"] == expected
     assert report["folds"] == ["load=80", "load=180", "load=300"]
     labels = [c["label"] for c in report["candidates"]]
-    assert set(labels) >= {"soil_only", "grousers", "slip_sinkage", "bulldozing"}
+    assert set(labels) >= {"soil_only", "grousers(bekker1956)", "slip_sinkage(ding2011)",
+                           "bulldozing(bekker1969)"}
+    assert report["decision"]["law_sensitivity"]["one_law_only"]
     if expected:
-        chosen = next(c for c in report["candidates"] if c["label"] == expected[0])
+        chosen = next(c for c in report["candidates"] if c["label"] == report["decision"]["chosen"])
+        assert chosen["effects"] == expected
         soil = next(c for c in report["candidates"] if c["label"] == "soil_only")
         assert chosen["held_out_score"] < 0.6 * soil["held_out_score"]
         assert report["shrink"]["shrink_pct"]["dp_n"] > 40.0
@@ -216,3 +222,21 @@ def test_pairs_vary_one_law_at_a_time():
     assert model.effects["slip_sinkage"].coefficient == 0.5
     with pytest.raises(KeyError, match="unknown law 'x' of effect 'grousers'"):
         candidates.allowed_laws(BASE, ["grousers"], {"grousers": ("x",)})
+
+
+def test_lug_sinkage_mimics_soil_slip_sinkage_on_one_grousered_wheel():
+    """Ding 2011 lugs add n1_lug = kappa h / r to the sinkage exponent's slip slope: on one
+    grousered wheel soil slip-sinkage n1 = 0.6 reads as lugs with kappa = 0.6 r / h and
+    no extra shear radius. Under every law the call is inconclusive, and the test that
+    tells them apart is a smooth wheel."""
+    truth = BASE.with_soil(**TRUTH_SOIL).with_effects(slip_sinkage={"n1": 0.6})
+    report = diagnose(synthetic_points(truth), Simulated(BASE), CANDIDATES, FAST)
+    assert report["verdict"] == "inconclusive"
+    assert set(report["decision"]["leaders"]) == {"slip_sinkage(ding2011)",
+                                                  "grousers(ding2011)"}
+    lugs = next(c for c in report["candidates"] if c["label"] == "grousers(ding2011)")
+    kappa = 0.6 * BASE.wheel.radius_m / BASE.wheel.grouser_height_m  # 8.15
+    assert lugs["parameters"]["effects.grousers.lug_sinkage_gain"] == pytest.approx(kappa,
+                                                                                  rel=0.05)
+    assert lugs["parameters"]["effects.grousers.shear_radius_factor"] < 0.1
+    assert report["decision"]["separating_test"]["test"].startswith("run a smooth wheel")
