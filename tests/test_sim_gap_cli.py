@@ -9,7 +9,9 @@ from sqlalchemy import select
 
 import terramechanics as tm
 import virtual_testbed as vt
-from validation.gap_bench import FAST_DESIGN, base_model, conditions, run_bench, score
+from swtlab_cli.cmd_gap import parse_laws
+from validation.gap_bench import (FAST_DESIGN, base_model, conditions, run_bench, score,
+                                   truth_law)
 from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import GapReport
@@ -26,8 +28,10 @@ def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
     db = f"sqlite:///{tmp_path / 'swt.sqlite'}"
     assert main(["process", str(tmp_path / "out" / "campaign"), "--db", db, "--quiet"]) == 0
     tm.save_model(base_model(), tmp_path / "sim.toml")
+    default_laws = ",".join(f"{e}={law}" for e, law in tm.DEFAULT_LAWS.items())
     code = main(["gap", "--measured", db, "--sim", str(tmp_path / "sim.toml"), "--json",
-                 str(tmp_path / "gap.json"), "--html", str(tmp_path / "gap.html"), "--boot", "20"])
+                 str(tmp_path / "gap.json"), "--html", str(tmp_path / "gap.html"), "--boot", "20",
+                 "--laws", default_laws])
     assert code == 0
     report = json.loads((tmp_path / "gap.json").read_text())
     assert REQUIRED <= set(report)
@@ -55,19 +59,32 @@ def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
 def test_gap_cli_bad_input(tmp_path, capsys):
     assert main(["gap", "--measured", str(tmp_path / "none.csv"), "--sim", "x.toml"]) == 3
     assert main(["gap", "--measured", "a", "--sim", "b", "--effects", "wings"]) == 2
+    assert main(["gap", "--measured", "a", "--sim", "b", "--laws", "grousers=x"]) == 2
+    assert "unknown law 'x' of effect 'grousers'" in capsys.readouterr().err
+    assert parse_laws("grousers=ding2011,grousers=bekker1956,slip_sinkage=lyasko2010") == {
+        "grousers": ("ding2011", "bekker1956"), "slip_sinkage": ("lyasko2010",)}
 
 
 def test_gap_bench_is_blind_and_scored_from_labels(tmp_path):
-    result = run_bench(3, seed=4, workdir=tmp_path, design=FAST_DESIGN, jobs=2, boot=10)
+    """Held-out truth laws: one law per family left (so as fast as one law per effect)."""
+    result = run_bench(3, seed=4, workdir=tmp_path, design=FAST_DESIGN, jobs=2, boot=10,
+                       truth_laws="held-out")
     labels = json.loads((tmp_path / "labels" / "labels.json").read_text())
     assert sorted(labels) == ["c000", "c001", "c002"]
-    for name in labels:  # the diagnosis saw no truth: it lives outside the campaign folder
+    for i, name in enumerate(labels):  # the diagnosis saw no truth: it lives outside
         assert not (tmp_path / name / "truth").exists()
         assert (tmp_path / "labels" / name / "truth").is_dir()
-        assert (tmp_path / name / "gap.json").is_file()
+        report = json.loads((tmp_path / name / "gap.json").read_text())
+        allowed = report["settings"]["laws"]  # every family lost the truth's law
+        assert sorted(allowed) == sorted(tm.LAWS)
+        for effect, options in allowed.items():
+            assert sorted(options + [truth_law(i, effect)]) == sorted(tm.LAWS[effect])
+        for effect, law in labels[name]["laws"].items():
+            assert law == truth_law(i, effect) and law not in allowed[effect]
+            assert labels[name]["truth_laws"] == "held-out"
     assert result["n"] == 3 and sum(v["n"] for v in result["by_class"].values()) == 3
     assert result == {**score(tmp_path / "labels" / "labels.json", tmp_path),
-                      "timing_s": result["timing_s"]}
+                      "truth_laws": "held-out", "timing_s": result["timing_s"]}
     rows = {r["campaign"]: r for r in result["campaigns"]}
     assert [rows[n]["hidden"] for n in sorted(rows)] == [labels[n]["effects"]
                                                          for n in sorted(labels)]
