@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from sqlalchemy import select
 
 import terramechanics as tm
 import virtual_testbed as vt
 from swtlab_cli.cmd_gap import parse_laws
-from validation.gap_bench import (FAST_DESIGN, base_model, conditions, run_bench, score,
-                                   truth_law)
+from validation.gap_bench import (FAST_DESIGN, base_model, conditions, diagnosis_laws,
+                                   laws_option, make_campaigns, run_bench, score, truth_law)
 from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import GapReport
@@ -88,3 +89,13 @@ def test_gap_bench_is_blind_and_scored_from_labels(tmp_path):
     rows = {r["campaign"]: r for r in result["campaigns"]}
     assert [rows[n]["hidden"] for n in sorted(rows)] == [labels[n]["effects"]
                                                          for n in sorted(labels)]
+
+
+def test_gap_bench_modes_are_checked(tmp_path):
+    with pytest.raises(ValueError, match="signal_model must be one of"):
+        make_campaigns(1, 0, tmp_path, FAST_DESIGN, 1, signal_model="third")
+    with pytest.raises(ValueError, match="truth_laws must be one of"):
+        diagnosis_laws(0, "mixed")
+    assert laws_option(None) == ""
+    assert laws_option({"grousers": ("bekker1956",), "slip_sinkage": ("ding2011", "x")}) == (
+        "grousers=bekker1956,slip_sinkage=ding2011,slip_sinkage=x")
