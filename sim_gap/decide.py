@@ -11,11 +11,16 @@ sec. 7.10, on paired per-run held-out losses):
 3. the chosen one is the simplest tied candidate (fewest effects, then fewest parameters,
    then lowest loss);
 4. it is a confident call only if (a) no other tied candidate has as few effects but a
-   different set, (b) it beats soil-only recalibration by ``Z_CONFIDENT`` standard errors
-   (when it has an effect) and by ``MIN_GAIN`` of its loss, and (c) its held-out loss stays
-   below ``UNEXPLAINED_LOSS`` (else an effect outside the candidates is at work);
-   otherwise the verdict is ``inconclusive`` with the reason and the test that separates
-   the leaders.
+   different set, (b) every effect in it earns its place: the call beats the call without
+   that effect (soil-only recalibration for a single, the other single for a pair) by
+   ``Z_CONFIDENT`` standard errors and by ``MIN_GAIN`` of its loss, and (c) its held-out
+   loss stays below ``UNEXPLAINED_LOSS`` (else an effect outside the candidates is at
+   work); otherwise the verdict is ``inconclusive`` with the reason and the test that
+   separates the leaders.
+
+(b) for a pair guards against a second effect that only patches the shape of the first
+one's law (the out-of-family bench: a flexible wheel under the wrong flexibility law
+called "grousers + wheel_flexibility" with 11 % gain over wheel_flexibility alone).
 """
 
 from __future__ import annotations
@@ -68,6 +73,12 @@ def rank(results: dict[str, CrossValidated], n_points: int) -> list[dict]:
     return out
 
 
+def _nested(effects: list[str]) -> list[str]:
+    """Labels of a pair's two singles (none for fewer effects: soil-only is tested apart)."""
+    return [] if len(effects) < 2 else ["+".join(x for x in effects if x != e)
+                                        for e in effects]
+
+
 def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
     """Verdict from the ranking (see the module docstring). Returns ``verdict`` (list of
     effects or ``"inconclusive"``), ``chosen`` (label), ``leaders`` (labels to separate when
@@ -93,6 +104,14 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
         return {**out, "verdict": "inconclusive", "leaders": [chosen["label"], "soil_only"],
                 "reason": f"{chosen['label']} improves on soil-only recalibration by only "
                           f"{z_soil:.1f} SE ({100 * gain:.0f} % of the held-out loss)"}
+    for label in _nested(chosen["effects"]):
+        z, g = paired_z(losses[label], mine), 1.0 - mine.mean() / losses[label].mean()
+        if z < Z_CONFIDENT or g < MIN_GAIN:
+            extra = next(e for e in chosen["effects"] if e not in label.split("+"))
+            return {**out, "verdict": "inconclusive", "leaders": [chosen["label"], label],
+                    "reason": f"{chosen['label']} improves on {label} alone by only "
+                              f"{z:.1f} SE ({100 * g:.0f} % of the held-out loss): {extra} "
+                              "may only be patching the shape of the other effect's law"}
     if chosen["held_out_loss"] > UNEXPLAINED_LOSS:
         return {**out, "verdict": "inconclusive", "leaders": [], "unexplained": True,
                 "reason": f"the best explanation ({chosen['label']}) leaves a held-out gap "
@@ -102,6 +121,7 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
             "reason": "no missing effect: soil recalibration explains the data"
                       if not chosen["effects"] else
                       f"{chosen['label']} beats soil-only recalibration by {z_soil:.1f} SE "
-                      f"({100 * gain:.0f} % of the held-out loss) and every rival of the "
-                      "same size by more than "
-                      f"{Z_TIE:g} SE"}
+                      f"({100 * gain:.0f} % of the held-out loss)"
+                      + (f", each of its singles by at least {Z_CONFIDENT:g} SE"
+                         if len(chosen["effects"]) > 1 else "")
+                      + f", and every rival of the same size by more than {Z_TIE:g} SE"}

@@ -9,7 +9,7 @@ import pytest
 
 import terramechanics as tm
 from sim_gap import candidates
-from sim_gap.decide import decide, rank
+from sim_gap.decide import decide, paired_z, rank
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.discriminate import separating_test
 from sim_gap.laws import assignments, reference_laws, robust_decide
@@ -152,6 +152,27 @@ def test_decide_weak_gain_and_unexplained_gap_are_inconclusive():
     out = decide(rank(_fake(big), 30), big)
     assert out["verdict"] == "inconclusive" and out.get("unexplained")
     assert "outside the candidate set" in out["reason"]
+
+
+def test_a_pair_is_called_only_if_each_effect_earns_its_place():
+    """The pair beats wheel_flexibility alone consistently (> the 2 SE tie, so the single
+    is not tied) but by 10 % of the loss only: the second effect may only patch the first
+    one's law."""
+    rng = np.random.default_rng(4)
+    flex = 1.0 + rng.normal(0, 0.3, 40)
+    losses = {"soil_only": 6 + rng.normal(0, 0.1, 40), "grousers": 5 + rng.normal(0, 0.1, 40),
+              "wheel_flexibility": flex, "grousers+wheel_flexibility": 0.9 * flex - 0.01
+              + rng.normal(0, 0.05, 40)}
+    out = decide(rank(_fake(losses), 40), losses)
+    assert paired_z(losses["wheel_flexibility"], losses["grousers+wheel_flexibility"]) > 4
+    assert out["chosen"] == "grousers+wheel_flexibility"
+    assert out["verdict"] == "inconclusive"
+    assert out["leaders"] == ["grousers+wheel_flexibility", "wheel_flexibility"]
+    assert "improves on wheel_flexibility alone by only" in out["reason"]
+    losses["grousers+wheel_flexibility"] = 0.5 * flex + rng.normal(0, 0.02, 40)
+    out = decide(rank(_fake(losses), 40), losses)
+    assert out["verdict"] == ["grousers", "wheel_flexibility"]
+    assert "each of its singles by at least 4 SE" in out["reason"]
 
 
 def test_candidates_free_the_fit_parameters_their_law_declares():
