@@ -2,18 +2,23 @@
 
 Each effect is a family of published laws (``terramechanics.effects.LAWS``); real physics
 follows none of them exactly. A verdict is confident only if the decision rule
-(``sim_gap.decide``) gives the same confident verdict under every law assignment tried:
-the reference assignment (each effect under the law that scored best alone) and each
-effect switched to each of its other laws, one at a time (a one-at-a-time sensitivity
-design, Saltelli et al. 2008, Global Sensitivity Analysis: The Primer, ch. 2). Any
-disagreement makes the verdict ``inconclusive``, naming the laws that disagree. Nothing
-here (nor in ``decide``) reads the shrink: a large shrink never raises confidence.
+(``sim_gap.decide``) gives the same confident verdict under every law assignment that
+could have made the data: the reference assignment (each effect under the law that scored
+best alone) and each effect switched to each of its other laws, one at a time (a
+one-at-a-time sensitivity design, Saltelli et al. 2008, Global Sensitivity Analysis: The
+Primer, ch. 2). An assignment whose best candidate loses to the reference's best by the
+margin of a confident call (``Z_CONFIDENT`` paired SE and ``MIN_GAIN`` of its held-out
+loss) is *refuted by the data*: it is listed, and does not vote. Any disagreement among the others makes the verdict
+``inconclusive``, naming the laws that disagree. Nothing here (nor in ``decide``) reads
+the shrink: a large shrink never raises confidence.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
 from sim_gap.crossval import CrossValidated
-from sim_gap.decide import decide, rank
+from sim_gap.decide import MIN_GAIN, Z_CONFIDENT, decide, paired_z, rank
 
 
 def reference_laws(singles: dict[str, CrossValidated], n_points: int) -> dict[str, str]:
@@ -72,14 +77,21 @@ def robust_decide(results: dict[str, CrossValidated], allowed: dict[str, tuple[s
         tried.append({"laws_changed": _changed(laws, reference), "verdict": d["verdict"],
                       "chosen": key_of(d["chosen"], laws), "reason": d["reason"],
                       "leaders": [key_of(label, laws) for label in d["leaders"]],
-                      "decision": d})
+                      "decision": d, "best": min(losses.values(), key=np.mean)})
     ref = tried[0]
-    disagree = [t for t in tried[1:] if t["verdict"] != ref["verdict"]
-                or t["verdict"] == "inconclusive"]
+    for t in tried:
+        t["z_best_vs_reference"] = paired_z(t["best"], ref["best"]) if t is not ref else 0.0
+        gain = 1.0 - ref["best"].mean() / t["best"].mean() if t["best"].mean() > 0 else 0.0
+        t["refuted"] = t["z_best_vs_reference"] >= Z_CONFIDENT and gain >= MIN_GAIN
+    disagree = [t for t in tried[1:] if not t["refuted"] and (
+        t["verdict"] != ref["verdict"] or t["verdict"] == "inconclusive")]
     sensitivity = {
         "reference_laws": reference, "laws_tried": {e: list(v) for e, v in allowed.items()},
-        "assignments": [{k: t[k] for k in ("laws_changed", "verdict", "chosen", "reason")}
+        "assignments": [{k: t[k] for k in ("laws_changed", "verdict", "chosen", "reason",
+                                           "z_best_vs_reference", "refuted")}
                         for t in tried],
+        "refuted": [{"effect": e, "law": law, "z_best_vs_reference": t["z_best_vs_reference"]}
+                    for t in tried if t["refuted"] for e, law in t["laws_changed"].items()],
         "disagreeing": [{"effect": e, "law": law, "verdict": t["verdict"],
                          "chosen": t["chosen"]}
                         for t in disagree for e, law in t["laws_changed"].items()],
@@ -87,6 +99,11 @@ def robust_decide(results: dict[str, CrossValidated], allowed: dict[str, tuple[s
         "one_law_only": all(len(v) == 1 for v in allowed.values())}
     out = {**ref["decision"], "chosen": ref["chosen"], "leaders": ref["leaders"],
            "law_sensitivity": sensitivity}
+    if sensitivity["refuted"] and ref["verdict"] != "inconclusive" and not disagree:
+        out["reason"] += ("; under " + ", ".join(f"{r['effect']} {r['law']}"
+                                                   for r in sensitivity["refuted"])
+                          + " the best explanation loses to this one by the margin of a "
+                          "confident call: refuted by the data, so not counted")
     if ref["verdict"] == "inconclusive" or not disagree:
         return out
     rivals = [k for t in disagree for k in [t["chosen"], *t["leaders"]] if k != ref["chosen"]]
