@@ -8,9 +8,9 @@ best alone) and each effect switched to each of its other laws, one at a time (a
 one-at-a-time sensitivity design, Saltelli et al. 2008, Global Sensitivity Analysis: The
 Primer, ch. 2). An assignment whose best candidate loses to the reference's best by the
 margin of a confident call (``Z_CONFIDENT`` paired SE and ``MIN_GAIN`` of its held-out
-loss) is *refuted by the data*: it is listed, and does not vote. Any disagreement among the others makes the verdict
-``inconclusive``, naming the laws that disagree. Nothing here (nor in ``decide``) reads
-the shrink: a large shrink never raises confidence.
+loss) is *refuted by the data*: it is listed, and does not vote. Any disagreement among
+the others makes the verdict ``inconclusive``, naming the laws that disagree. Nothing here
+(nor in ``decide``) reads the shrink: a large shrink never raises confidence.
 """
 
 from __future__ import annotations
