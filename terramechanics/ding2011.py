@@ -5,7 +5,10 @@ performance for planetary exploration rovers moving in deformable soil", J.
 Terramechanics 48(1):27-45: a smooth and a 10 mm lug wheel (R = 157.35 mm, b = 165
 mm) on their planetary soil simulant. Points and soil as digitised by roverdevkit
 (``terramechanics/data/ding2011_80n.csv`` names the source). ``errors`` gives the
-median relative errors of DP and sinkage that the issue's accuracy targets use.
+median relative errors of DP and sinkage that the issue's accuracy targets use (and of
+the torque, which no fit here uses). ``fit_slip_soil`` fits the slip-dependent shear
+modulus of Ding et al. 2015 (``terramechanics/slip_soil_ding2015.py``) and the
+slip-sinkage exponent on one wheel, so that the other can be held out.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import brentq
+from scipy.optimize import brentq, least_squares
 
 from terramechanics.model import WheelModel
 from terramechanics.soil import SoilParams
@@ -53,15 +56,21 @@ def predict(model: WheelModel, points: pd.DataFrame, name: str) -> dict[str, np.
     out = model.with_wheel(radius_m=w.radius_m, width_m=w.width_m, grouser_count=w.grouser_count,
                            grouser_height_m=w.grouser_height_m).curves(LOAD_N, rows["slip"])
     return {"slip": rows["slip"].to_numpy(), "dp_n": out["dp_n"], "sinkage_m": out["sinkage_m"],
-            "dp_meas_n": rows["dp_n"].to_numpy(), "sinkage_meas_m": rows["sinkage_m"].to_numpy()}
+            "torque_nm": out["torque_nm"], "dp_meas_n": rows["dp_n"].to_numpy(),
+            "sinkage_meas_m": rows["sinkage_m"].to_numpy(),
+            "torque_meas_nm": rows["torque_nm"].to_numpy()}
 
 
 def errors(model: WheelModel, points: pd.DataFrame, name: str) -> dict[str, float]:
-    """Median |relative error| of DP and of sinkage over the wheel's points."""
+    """Median |relative error| of DP and of sinkage over the wheel's points, and of the
+    torque over those with a torque reported (> 0; the towed s = 0 point has none)."""
     p = predict(model, points, name)
+    driven = p["torque_meas_nm"] > 0
     return {"dp_median_rel": float(np.median(np.abs(p["dp_n"] / p["dp_meas_n"] - 1))),
             "sinkage_median_rel": float(np.median(np.abs(p["sinkage_m"]
-                                                         / p["sinkage_meas_m"] - 1)))}
+                                                         / p["sinkage_meas_m"] - 1))),
+            "torque_median_rel": float(np.median(np.abs(p["torque_nm"][driven]
+                                                        / p["torque_meas_nm"][driven] - 1)))}
 
 
 def static_stiffness_factor(model: WheelModel, points: pd.DataFrame) -> float:
@@ -77,3 +86,34 @@ def static_stiffness_factor(model: WheelModel, points: pd.DataFrame) -> float:
                      - target)
 
     return brentq(miss, 0.1, 100.0, xtol=1e-4)
+
+
+#: start and bounds of (K0 m, K1 m, n1) in :func:`fit_slip_soil`
+SLIP_SOIL_START = (0.004, 0.02, 0.9)
+SLIP_SOIL_BOUNDS = ((1e-4, 0.0, 0.0), (0.05, 0.1, 2.0))
+
+
+def fit_slip_soil(model: WheelModel, points: pd.DataFrame, name: str,
+                  slip_shear: bool = True) -> WheelModel:
+    """``model`` with K = K0 + K1 s (Ding et al. 2015) and the ``slip_sinkage`` (ding2011)
+    n1 fitted by least squares to wheel ``name``'s relative DP and sinkage errors (with
+    ``slip_shear=False``: K1 = 0, a constant K fitted instead); raises if a value ends on
+    a bound (then it is no fit)."""
+    free = [0, 1, 2] if slip_shear else [0, 2]
+
+    def make(x) -> WheelModel:
+        k0, k1, n1 = x if slip_shear else (x[0], 0.0, x[1])
+        return model.with_soil(shear_modulus_m=k0, shear_modulus_slip_m=k1).with_effects(
+            slip_sinkage={"law": "ding2011", "n1": n1})
+
+    def residuals(x) -> np.ndarray:
+        p = predict(make(x), points, name)
+        return np.concatenate([p["dp_n"] / p["dp_meas_n"] - 1,
+                               p["sinkage_m"] / p["sinkage_meas_m"] - 1])
+
+    lower, upper = (np.asarray(b)[free] for b in SLIP_SOIL_BOUNDS)
+    fit = least_squares(residuals, np.asarray(SLIP_SOIL_START)[free], bounds=(lower, upper),
+                        diff_step=1e-3)
+    if np.any(np.isclose(fit.x, lower, rtol=1e-3, atol=1e-6) | np.isclose(fit.x, upper)):
+        raise RuntimeError(f"fit on {name} ends on a bound: {fit.x}")
+    return make(fit.x)
