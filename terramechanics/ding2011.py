@@ -1,6 +1,6 @@
 """Ding et al. (2011) single-wheel tests at 80 N: the published curves, soil and wheels.
 
-Ding, Gao, Deng & Tao (2011) "Experimental study and analysis on driving wheels'
+Ding, Gao, Deng, Nagatani & Yoshida (2011) "Experimental study and analysis on driving wheels'
 performance for planetary exploration rovers moving in deformable soil", J.
 Terramechanics 48(1):27-45: a smooth and a 10 mm lug wheel (R = 157.35 mm, b = 165
 mm) on their planetary soil simulant. Points and soil as digitised by roverdevkit
@@ -31,7 +31,7 @@ WHEELS = ("smooth", "lug10")
 SOIL = SoilParams(
     kc=15.6e3, kphi=2407.4e3, n=1.10, cohesion_pa=250.0, friction_angle_deg=31.9,
     shear_modulus_m=0.011, density_kg_m3=1605.0, name="ding2011_simulant",
-    source="Ding, Gao, Deng & Tao 2011, J. Terramech. 48(1):27-45, Table 2: n = 1.10, "
+    source="Ding, Gao, Deng, Nagatani & Yoshida 2011, J. Terramech. 48(1):27-45, Table 2: n = 1.10, "
            "kc = 15.6, kphi = 2407.4 (kN units), c = 0.25 kPa, phi = 31.9 deg, K = 9.7-13.1 "
            "mm (11 mm used), 1605 kg/m^3; as tabulated by roverdevkit data/soil_simulants.csv")
 
@@ -88,32 +88,34 @@ def static_stiffness_factor(model: WheelModel, points: pd.DataFrame) -> float:
     return brentq(miss, 0.1, 100.0, xtol=1e-4)
 
 
-#: start and bounds of (K0 m, K1 m, n1) in :func:`fit_slip_soil`
-SLIP_SOIL_START = (0.004, 0.02, 0.9)
-SLIP_SOIL_BOUNDS = ((1e-4, 0.0, 0.0), (0.05, 0.1, 2.0))
+#: start, lower and upper bound of each parameter :func:`fit_slip_soil` may free
+SLIP_SOIL_PARAMS = {"K0": (0.004, 1e-4, 0.05), "K1": (0.02, 0.0, 0.1), "n1": (0.9, 0.0, 2.0)}
 
 
 def fit_slip_soil(model: WheelModel, points: pd.DataFrame, name: str,
-                  slip_shear: bool = True) -> WheelModel:
-    """``model`` with K = K0 + K1 s (Ding et al. 2015) and the ``slip_sinkage`` (ding2011)
-    n1 fitted by least squares to wheel ``name``'s relative DP and sinkage errors (with
-    ``slip_shear=False``: K1 = 0, a constant K fitted instead); raises if a value ends on
-    a bound (then it is no fit)."""
-    free = [0, 1, 2] if slip_shear else [0, 2]
+                  free: tuple[str, ...] = ("K0", "K1", "n1")) -> WheelModel:
+    """``model`` with the ``free`` ones of K0, K1 of ``K = K0 + K1 s`` (Ding et al. 2015)
+    and n1 of the ``slip_sinkage`` law ding2011 fitted by least squares to wheel
+    ``name``'s relative DP and sinkage errors (K1 not free: 0, a constant K; n1 not free:
+    no slip-sinkage). Raises if a value ends on a bound: then it is no fit."""
+    start, lower, upper = (np.array([SLIP_SOIL_PARAMS[p][i] for p in free]) for i in range(3))
 
     def make(x) -> WheelModel:
-        k0, k1, n1 = x if slip_shear else (x[0], 0.0, x[1])
-        return model.with_soil(shear_modulus_m=k0, shear_modulus_slip_m=k1).with_effects(
-            slip_sinkage={"law": "ding2011", "n1": n1})
+        value = dict(zip(free, x))
+        fitted = model.with_soil(shear_modulus_m=value["K0"],
+                                 shear_modulus_slip_m=value.get("K1", 0.0))
+        if "n1" in value:
+            fitted = fitted.with_effects(slip_sinkage={"law": "ding2011", "n1": value["n1"]})
+        return fitted
 
     def residuals(x) -> np.ndarray:
         p = predict(make(x), points, name)
         return np.concatenate([p["dp_n"] / p["dp_meas_n"] - 1,
                                p["sinkage_m"] / p["sinkage_meas_m"] - 1])
 
-    lower, upper = (np.asarray(b)[free] for b in SLIP_SOIL_BOUNDS)
-    fit = least_squares(residuals, np.asarray(SLIP_SOIL_START)[free], bounds=(lower, upper),
-                        diff_step=1e-3)
-    if np.any(np.isclose(fit.x, lower, rtol=1e-3, atol=1e-6) | np.isclose(fit.x, upper)):
-        raise RuntimeError(f"fit on {name} ends on a bound: {fit.x}")
+    fit = least_squares(residuals, start, bounds=(lower, upper), diff_step=1e-3)
+    on_bound = [f"{p} = {v:.3g}" for p, v, lo, hi in zip(free, fit.x, lower, upper)
+                if np.isclose(v, lo, rtol=1e-3, atol=1e-6) or np.isclose(v, hi, rtol=1e-3)]
+    if on_bound:
+        raise RuntimeError(f"fit on {name} ends on a bound ({', '.join(on_bound)})")
     return make(fit.x)
