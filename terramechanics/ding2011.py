@@ -31,9 +31,10 @@ WHEELS = ("smooth", "lug10")
 SOIL = SoilParams(
     kc=15.6e3, kphi=2407.4e3, n=1.10, cohesion_pa=250.0, friction_angle_deg=31.9,
     shear_modulus_m=0.011, density_kg_m3=1605.0, name="ding2011_simulant",
-    source="Ding, Gao, Deng, Nagatani & Yoshida 2011, J. Terramech. 48(1):27-45, Table 2: n = 1.10, "
-           "kc = 15.6, kphi = 2407.4 (kN units), c = 0.25 kPa, phi = 31.9 deg, K = 9.7-13.1 "
-           "mm (11 mm used), 1605 kg/m^3; as tabulated by roverdevkit data/soil_simulants.csv")
+    source="Ding, Gao, Deng, Nagatani & Yoshida 2011, J. Terramech. 48(1):27-45, Table 2: "
+           "n = 1.10, kc = 15.6, kphi = 2407.4 (kN units), c = 0.25 kPa, phi = 31.9 deg, "
+           "K = 9.7-13.1 mm (11 mm used), 1605 kg/m^3; as tabulated by roverdevkit "
+           "data/soil_simulants.csv")
 
 
 def load_points() -> pd.DataFrame:

@@ -7,8 +7,9 @@ the exponent may vary (slip-sinkage effect). Shear strength Mohr-Coulomb
 ``c1, c2`` set the Wong & Reece (1967) maximum-stress angle
 ``theta_m = (c1 + c2 s) theta_1``; ``c3`` the rear (exit) angle
 ``theta_2 = -c3 theta_1``. ``shear_modulus_slip_m`` (K1) and ``c4`` make K and the exit
-angle grow with driving slip, ``K = K0 + K1 s`` (K0 = shear_modulus_m) and ``theta_2 = -(c3 + c4 s) theta_1``
-(Ding et al. 2015, ``terramechanics/slip_soil_ding2015.py``); both 0 by default.
+angle grow with driving slip, ``K = K0 + K1 s`` (K0 = shear_modulus_m) and
+``theta_2 = -(c3 + c4 s) theta_1`` (Ding et al. 2015, J. Field Robotics 32(6);
+``terramechanics/slip_soil_ding2015.py``); both 0 by default.
 """
 
 from __future__ import annotations
