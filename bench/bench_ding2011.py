@@ -10,7 +10,8 @@ the lug-sinkage gain on the lug wheel (in-sample, marked ``fit``). ``slip_shear`
 slip-dependent shear modulus K = K0 + K1 s of Ding et al. 2015
 (``terramechanics/slip_soil_ding2015.py``) with the slip-sinkage n1, fitted on one wheel
 (``ding2011.fit_slip_soil``, grousers ``bekker1956`` on, idle on the smooth wheel) and
-held out on the other; ``constant K`` is the same fit with K1 = 0, the control. No
+held out on the other (``+ exit angle c4``: with the slope of Ding's exit angle
+freed too); ``constant K`` is the same fit with K1 = 0, the control. No
 K0, K1 for this simulant is published in a source swtlab has, so every slip_shear row
 is fitted. The torque column is never fitted.
 """
@@ -68,6 +69,7 @@ def slip_shear_cases(base: WheelModel, points) -> list[tuple[str, str, WheelMode
     out = []
     for label, free in (("slip_shear ding2015 + slip_sinkage ding2011", ("K0", "K1", "n1")),
                         ("slip_shear ding2015, no slip_sinkage", ("K0", "K1")),
+                        ("slip_shear + exit angle c4 + slip_sinkage", ("K0", "K1", "n1", "c4")),
                         ("constant K + slip_sinkage ding2011", ("K0", "n1"))):
         for fitted_on in ding2011.WHEELS:
             try:

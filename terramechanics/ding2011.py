@@ -90,21 +90,24 @@ def static_stiffness_factor(model: WheelModel, points: pd.DataFrame) -> float:
 
 
 #: start, lower and upper bound of each parameter :func:`fit_slip_soil` may free
-SLIP_SOIL_PARAMS = {"K0": (0.004, 1e-4, 0.05), "K1": (0.02, 0.0, 0.1), "n1": (0.9, 0.0, 2.0)}
+SLIP_SOIL_PARAMS = {"K0": (0.004, 1e-4, 0.05), "K1": (0.02, 0.0, 0.1), "n1": (0.9, 0.0, 2.0),
+                    "c4": (0.2, 0.0, 1.0)}
 
 
 def fit_slip_soil(model: WheelModel, points: pd.DataFrame, name: str,
                   free: tuple[str, ...] = ("K0", "K1", "n1")) -> WheelModel:
-    """``model`` with the ``free`` ones of K0, K1 of ``K = K0 + K1 s`` (Ding et al. 2015)
-    and n1 of the ``slip_sinkage`` law ding2011 fitted by least squares to wheel
-    ``name``'s relative DP and sinkage errors (K1 not free: 0, a constant K; n1 not free:
-    no slip-sinkage). Raises if a value ends on a bound: then it is no fit."""
+    """``model`` with the ``free`` ones of K0, K1 of ``K = K0 + K1 s`` and c4 of
+    ``theta_2 = -(c3 + c4 s) theta_1`` (Ding et al. 2015) and n1 of the ``slip_sinkage``
+    law ding2011 fitted by least squares to wheel ``name``'s relative DP and sinkage
+    errors (K1, c4 not free: 0, constant; n1 not free: no slip-sinkage). Raises if a
+    value ends on a bound: then it is no fit."""
     start, lower, upper = (np.array([SLIP_SOIL_PARAMS[p][i] for p in free]) for i in range(3))
 
     def make(x) -> WheelModel:
         value = dict(zip(free, x))
         fitted = model.with_soil(shear_modulus_m=value["K0"],
-                                 shear_modulus_slip_m=value.get("K1", 0.0))
+                                 shear_modulus_slip_m=value.get("K1", 0.0),
+                                 c4=value.get("c4", 0.0))
         if "n1" in value:
             fitted = fitted.with_effects(slip_sinkage={"law": "ding2011", "n1": value["n1"]})
         return fitted
