@@ -67,7 +67,7 @@ def conditions(model: tm.WheelModel, quick: bool) -> list[RunCondition]:
                           grouser_count=w.grouser_count, grouser_height_m=w.grouser_height_m,
                           stiffness_n_per_mm=flex.radial_stiffness_n_m / 1000 if flex else None)
     loads = (80.0, 180.0, 300.0)
-    slips = (0.15, 0.45) if quick else (-0.2, 0.05, 0.15, 0.3, 0.45, 0.6)
+    slips = (0.15, 0.45) if quick else (-0.2, 0.05, 0.15, 0.3, 0.45, 0.6, 0.75)
     out = []
     for load in loads:
         for mp in (0,) if quick else (0, 1):

@@ -2,7 +2,8 @@
 ``<out>/truth/<run_id>.json`` (schema ``swtlab.second_rig.truth/1``), like a blind test.
 
 Each run draws from its own generator, seeded by the campaign seed and a SHA-256 of its run
-id, so a run's bytes do not depend on the rest of the campaign; no wall-clock time goes in.
+id, and its ``started_at`` comes from the seed and the run id, so a run's bytes do not depend on
+the rest of the campaign; no wall-clock time goes in.
 """
 
 from __future__ import annotations
@@ -104,8 +105,9 @@ def write_campaign(out_dir: str | Path, conditions: Iterable[RunCondition], trut
         folder.mkdir(parents=True, exist_ok=True)
     day0 = datetime(2026, 3, 2, 8, 0, tzinfo=UTC) + timedelta(days=int(seed) % 200)
     try:
-        for index, condition in enumerate(conditions):
-            started = (day0 + timedelta(minutes=4 * index)).isoformat()
+        for condition in conditions:
+            minutes = int.from_bytes(hashlib.sha256(condition.run_id.encode()).digest()[:4])
+            started = (day0 + timedelta(minutes=minutes % 600)).isoformat()
             topics, records, document, rng = make_run(condition, truth_fn, seed, started, rig)
             name = condition.run_id + (".mcap" if forms[condition.run_id] == "mcap" else "")
             if forms[condition.run_id] == "mcap":

@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
+FILE_MODE = 0o644  # temporary files are created 0600; the runs are meant to be shared
+
 
 def _blocks(n: int, rng: np.random.Generator, mean_samples: int) -> list[tuple[int, int]]:
     """Consecutive ``(start, stop)`` blocks of 1 to 2x ``mean_samples``, 5 % single samples."""
@@ -59,6 +61,7 @@ def write_mcap(path: Path, topics: dict, records: dict, rng: np.random.Generator
         for name, values in records.items():
             writer.add_metadata(name=f"swt.{name}", data={k: _text(v) for k, v in values.items()})
         writer.finish()
+    os.chmod(stream.name, FILE_MODE)
     os.replace(stream.name, path)
     return path
 
@@ -66,6 +69,7 @@ def write_mcap(path: Path, topics: dict, records: dict, rng: np.random.Generator
 def write_csv_folder(folder: Path, topics: dict, records: dict, staging: Path) -> Path:
     """One CSV-form run folder at ``folder`` (replaced whole if it exists)."""
     tmp = Path(tempfile.mkdtemp(dir=staging))
+    tmp.chmod(0o755)
     (tmp / "run.json").write_text(json.dumps(records, indent=1))
     for topic, fields in topics.items():
         names = [k for k in fields if k != "t_ns"]
@@ -83,5 +87,6 @@ def write_json(path: Path, document: dict, staging: Path) -> Path:
     """A JSON file written whole or not at all."""
     with tempfile.NamedTemporaryFile("w", dir=staging, suffix=".json", delete=False) as f:
         json.dump(document, f, indent=1)
+    os.chmod(f.name, FILE_MODE)
     os.replace(f.name, path)
     return path
