@@ -2,9 +2,10 @@
 
 Input: the rows of ``swtlab results --json`` (one per run) and the truth folder. For each run
 and quantity: ``error = mean - truth`` (truth: the noise-free window means), ``z = error/SE``
-and whether ``mean +- 1.96 SE`` covers the truth; also ``z`` after taking out the run's true
-load-cell drift over the window and gain error (``z_instrument_out``; diagnostic only: it
-reads the truth, no estimator can), which leaves the estimators' own errors (window, SE).
+and whether ``mean +- 1.96 SE`` covers the truth; also ``z`` after taking out what the
+instruments alone add (load-cell drift over the window, gain and offset errors, encoder clock
+rates: ``z_instrument_out``; diagnostic only: it reads the truth, no estimator can), which
+leaves the estimators' own errors (window, transient, SE, quantisation).
 """
 
 from __future__ import annotations
@@ -17,24 +18,42 @@ import pandas as pd
 
 QUANTITIES = ("slip", "travel_velocity_mps", "wheel_omega_radps", "wheel_load_n", "dp_n",
               "torque_nm", "thrust_n", "resistance_n", "sinkage_m")
-#: the load cell whose drift enters each quantity (R = T/r - DP: both, see ``_drift``)
-DRIFT_SOURCE = {"wheel_load_n": "/hub/wrench.fz", "dp_n": "/tether/force.dp",
-                "torque_nm": "/hub/wrench.ty"}
+#: the load cell behind each single-cell quantity
+CELL_OF = {"wheel_load_n": "/hub/wrench.fz", "dp_n": "/tether/force.dp",
+           "torque_nm": "/hub/wrench.ty"}
 
 
 def _instrument_error(quantity: str, truth: Mapping) -> float:
-    """The true drift (window mean) plus gain error of the cells behind ``quantity``."""
+    """What the instruments alone add to ``quantity``'s window mean: drift (window mean),
+    gain error and DP offset error of the load cells, the encoders' clock rate errors
+    (a clock fast by p reads rates low by p), and a flexible wheel's deflection error."""
     meas, means = truth["measurement"], truth["window_means"]
-    radius_m = truth["condition"]["wheel"]["radius_m"]
+    wheel = truth["condition"]["wheel"]
 
     def cell(key: str, value: float) -> float:
-        return meas["drift_window_mean"][key] + meas["gain_error_rel"][key] * value
+        offset = meas["dp_offset_error_n"] if key == "/tether/force.dp" else 0.0
+        return meas["drift_window_mean"][key] + meas["gain_error_rel"][key] * value + offset
 
-    if quantity in DRIFT_SOURCE:
-        return cell(DRIFT_SOURCE[quantity], means[quantity])
-    thrust = cell("/hub/wrench.ty", means["torque_nm"]) / radius_m
-    dp = cell("/tether/force.dp", means["dp_n"])
-    return {"thrust_n": thrust, "resistance_n": thrust - dp}.get(quantity, 0.0)
+    if quantity in CELL_OF:
+        return cell(CELL_OF[quantity], means[quantity])
+    thrust = cell("/hub/wrench.ty", means["torque_nm"]) / wheel["radius_m"]
+    if quantity in ("thrust_n", "resistance_n"):
+        return thrust - (cell("/tether/force.dp", means["dp_n"]) if quantity == "resistance_n"
+                         else 0.0)
+    if quantity == "sinkage_m":
+        k = wheel["stiffness_n_per_mm"]
+        return 0.0 if k is None else -cell(CELL_OF["wheel_load_n"],
+                                           means["wheel_load_n"]) / (1000 * k)
+    ppm = {t: c["rate_error_ppm"] * 1e-6 for t, c in meas["clocks"].items()}
+    v = means["travel_velocity_mps"] / (1 + ppm["/sled/encoder"])
+    omega = means["wheel_omega_radps"] / (1 + ppm["/wheel/encoder"])
+    if quantity == "travel_velocity_mps":
+        return v - means["travel_velocity_mps"]
+    if quantity == "wheel_omega_radps":
+        return omega - means["wheel_omega_radps"]
+    surface = wheel["radius_m"] * omega
+    slip = (surface - v) / (surface if surface >= v else v)
+    return slip - means["slip"]
 
 
 def score(rows: Iterable[Mapping], truth_dir: str | Path) -> pd.DataFrame:
@@ -61,7 +80,7 @@ def score(rows: Iterable[Mapping], truth_dir: str | Path) -> pd.DataFrame:
 
 def coverage(scores: pd.DataFrame) -> pd.DataFrame:
     """Per quantity: runs, coverage of ``mean +- 1.96 SE``, median and spread of z, the same
-    coverage with the true drift and gain errors taken out, and the median |error|."""
+    coverage with the instruments' errors taken out, and the median |error|."""
     def summary(g: pd.DataFrame) -> pd.Series:
         return pd.Series({"runs": len(g), "coverage": g["covered"].mean(),
                           "z_median": g["z"].median(), "z_std": g["z"].std(),
