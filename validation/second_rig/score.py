@@ -1,11 +1,17 @@
 """Score the chain's stored means against the second rig's truth files.
 
 Input: the rows of ``swtlab results --json`` (one per run) and the truth folder. For each run
-and quantity: ``error = mean - truth`` (truth: the noise-free window means), ``z = error/SE``
+and quantity: ``error = mean - truth``, ``z = error/SE``
 and whether ``mean +- 1.96 SE`` covers the truth; also ``z`` after taking out what the
 instruments alone add (load-cell drift over the window, gain and offset errors, encoder clock
 rates: ``z_instrument_out``; diagnostic only: it reads the truth, no estimator can), which
 leaves the estimators' own errors (window, transient, SE, quantisation).
+
+The truth (``target``) is by default the ``steady`` values (the caller's law, what a stable
+phase estimates); ``window_means`` (the noise-free signals over the rig's truth window) also
+carry that window's share of the drives' speed ripple, which the chain's window, another
+stretch of the run, does not share, and the two windows overlap, so they flatter or blur
+the speeds' coverage; the grouser wave averages out over both (whole periods).
 """
 
 from __future__ import annotations
@@ -23,11 +29,11 @@ CELL_OF = {"wheel_load_n": "/hub/wrench.fz", "dp_n": "/tether/force.dp",
            "torque_nm": "/hub/wrench.ty"}
 
 
-def _instrument_error(quantity: str, truth: Mapping) -> float:
+def _instrument_error(quantity: str, truth: Mapping, target: str) -> float:
     """What the instruments alone add to ``quantity``'s window mean: drift (window mean),
     gain error and DP offset error of the load cells, the encoders' clock rate errors
     (a clock fast by p reads rates low by p), and a flexible wheel's deflection error."""
-    meas, means = truth["measurement"], truth["window_means"]
+    meas, means = truth["measurement"], truth[target]
     wheel = truth["condition"]["wheel"]
 
     def cell(key: str, value: float) -> float:
@@ -56,7 +62,7 @@ def _instrument_error(quantity: str, truth: Mapping) -> float:
     return slip - means["slip"]
 
 
-def score(rows: Iterable[Mapping], truth_dir: str | Path) -> pd.DataFrame:
+def score(rows: Iterable[Mapping], truth_dir: str | Path, target: str = "steady") -> pd.DataFrame:
     """One row per (run, quantity) with a stored mean: mean, se, truth, error, z, covered,
     z_instrument_out; free-sled DP and R are left out (the DP cell has no tether)."""
     out = []
@@ -67,13 +73,13 @@ def score(rows: Iterable[Mapping], truth_dir: str | Path) -> pd.DataFrame:
             if mean is None or se is None or (row["mode"] == "free_sled"
                                               and q in ("dp_n", "resistance_n")):
                 continue
-            true = truth["window_means"][q]
+            true = truth[target][q]
             error = mean - true
             out.append({"run_id": row["run_id"], "mode": row["mode"], "quantity": q,
                         "mean": mean, "se": se, "truth": true, "error": error,
                         "z": error / se if se > 0 else float("inf"),
                         "covered": abs(error) <= 1.96 * se,
-                        "z_instrument_out": (error - _instrument_error(q, truth)) / se
+                        "z_instrument_out": (error - _instrument_error(q, truth, target)) / se
                         if se > 0 else float("inf")})
     return pd.DataFrame(out)
 
