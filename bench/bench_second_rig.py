@@ -145,12 +145,20 @@ def main(quick: bool = False) -> dict:
         rezeroed = rezeroed_coverage(scores, [{**r, "raw_radius_m": radius[r["run_id"]]}
                                               for r in ok], out)
         windowed = coverage(score(ok, out / "truth", target="window_means"))
+        truth_start = {p.stem: json.loads(p.read_text())["window"]["start_s"]
+                       for p in (out / "truth").glob("*.json")}
+        start_error = np.array([r["window_start_s"] - truth_start[r["run_id"]] for r in ok])
     table = coverage(scores)
     table["coverage_window_means"] = windowed["coverage"]
     table["coverage_rezeroed"] = pd.Series(rezeroed)
     statuses = {s: sum(r["status"] == s for r in rows) for s in {r["status"] for r in rows}}
     print(f"second rig: {len(runs)} runs, generated in {t1 - t0:.1f} s, processed in "
           f"{t2 - t1:.1f} s; status {statuses}")
+    print(f"window start - truth start (s): median {np.median(start_error):+.1f}, "
+          f"range {start_error.min():+.1f}..{start_error.max():+.1f}")
     print(table.round(3).to_string())
     return {"runs": len(runs), "statuses": statuses, "generate_s": t1 - t0,
-            "process_s": t2 - t1, "by_quantity": table.round(4).to_dict(orient="index")}
+            "process_s": t2 - t1, "window_start_error_s": {
+                "median": float(np.median(start_error)), "min": float(start_error.min()),
+                "max": float(start_error.max())},
+            "by_quantity": table.round(4).to_dict(orient="index")}
