@@ -13,14 +13,14 @@ from types import SimpleNamespace
 import pytest
 
 from campaign_report.figures import gap_heatmap
-from campaign_report.gap import (candidate_text, gap_blocks, gap_page, gap_section, plain,
-                                 write_gap_page)
-from campaign_report.html import Heading, Image, Table
+from campaign_report.gap import candidate_text, gap_page, gap_section, plain, write_gap_page
+from campaign_report.html import Heading, Image, render_page
 from campaign_report.style import EFFECTS, PARAMETERS, value_text
 from sim_gap.candidates import EFFECT_PARAMS, soil_params
 from sim_gap.diagnose import diagnose
 from sim_gap.report import build_report
 from sim_gap.simulated import Simulated
+from test_report_browser import CHROMIUM, probe
 from test_sim_gap_decide import BASE, FAST, synthetic_points
 
 #: numeric columns that count things and so have no unit
@@ -113,7 +113,7 @@ def test_gap_page_reads_as_plain_words_with_units(report, tmp_path):
     path = write_gap_page(report, tmp_path / "gap.html")
     page = check_page(path.read_text(encoding="utf-8"))
     text = " ".join(page.text)
-    assert "Reduced gravity is not testable with this campaign" in text
+    assert "Reduced gravity: not testable with this campaign; it changes no prediction" in text
     assert "gravity level other than the reference 9.81 m/s²" in text
     # the fitted soil of the best explanation, in display units (kN, mm), 3 significant digits
     best = report["candidates"][0]["parameters"]
@@ -144,10 +144,9 @@ def test_no_empty_table_and_region_sentence(report):
                                 "region": {k: region[k] for k in (
                                     "slip_band", "load_n", "multipass", "gravity_mps2",
                                     "quantity")}}
-    blocks = gap_blocks(quiet)
-    assert [b for b in blocks if isinstance(b, Table) and "slip band [%]" in b.header] == []
-    from campaign_report.html import render_page
-    text = " ".join(check_page(render_page(gap_page(quiet))).text)
+    page = check_page(render_page(gap_page(quiet)))
+    assert [t for t in page.tables if "slip band [%]" in t["header"]] == []
+    text = " ".join(page.text)
     assert "0 of" in text and "differ significantly" in text
     assert ("misses most in drawbar pull at slips 20 to 40 %, "
             f"{region['load_n']:g} N, multipass 0, 9.81 m/s²: mean residual +3.7 N "
@@ -159,7 +158,7 @@ def test_campaign_section_and_gap_page_share_the_renderer(report):
     data = SimpleNamespace(extras={"gap": {"sim_source": "sim.toml", "report": report}})
     section = gap_section(data, palette=None)
     page = gap_page(report)
-    assert section.blocks[1:] == gap_blocks(report) == page.sections[0].blocks
+    assert section.blocks[1:] == page.sections[0].blocks  # the same blocks, PNGs included
     assert isinstance(section.blocks[1], Heading) and section.blocks[1].text.startswith(
         "Verdict: ")
     assert sum(isinstance(b, Image) for b in section.blocks) == 2  # as given, recalibrated
@@ -201,3 +200,11 @@ def test_plain_words_and_display_units():
                                                     for e, ps in EFFECT_PARAMS.items()
                                                     for p in ps}
     assert fitted <= set(PARAMETERS) and set(EFFECT_PARAMS) <= set(EFFECTS)
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium not installed (.ci/chromium.sh)")
+def test_gap_page_opens_in_chromium_and_every_image_decodes(report, tmp_path):
+    page = write_gap_page(report, tmp_path / "gap.html")
+    found, console = probe(page, tmp_path)
+    assert found["images"] == 2 and found["decoded"] == ["ok", "ok"]
+    assert found["faults"] == [] and console == []
