@@ -61,7 +61,7 @@ def verdict_text(verdict) -> str:
         return verdict
     if not verdict:
         return "no missing effect"
-    return "missing " + " and ".join(EFFECTS.get(e, e) for e in verdict)
+    return "the simulation lacks " + " and ".join(EFFECTS.get(e, e) for e in verdict)
 
 
 def _parameters_text(values: dict[str, float]) -> str:
