@@ -42,17 +42,20 @@ def candidate_text(label: str) -> str:
     return " + ".join(EFFECTS.get(e, e) for e in label.split("+"))
 
 
-def plain(text: str, labels: list[str]) -> str:
-    """A reason of the report (written with the JSON's candidate labels and effect names) as
-    a sentence: each label by its plain name, standard errors and sigmas spelt out, a
-    capital first letter and a full stop."""
+def words(text: str, labels: list[str]) -> str:
+    """``text`` (written with the JSON's candidate labels and effect names) in plain words:
+    each label by its plain name, standard errors and sigmas spelt out."""
     names = sorted({n for n in {*labels, *EFFECTS, SOIL_ONLY} if "_" in n or "+" in n},
                    key=len, reverse=True)
     pattern = re.compile(r"(?<![\w+])(" + "|".join(map(re.escape, names)) + r")(?![\w+])")
     text = pattern.sub(lambda m: candidate_text(m.group(1)), text)
     text = re.sub(r"(\d) SE\b", r"\1 standard errors", text)
-    text = re.sub(r"\bsigma\b", "σ", text).replace("m/s^2", "m/s²")
-    text = text.strip()
+    return re.sub(r"\bsigma\b", "σ", text).replace("m/s^2", "m/s²").strip()
+
+
+def plain(text: str, labels: list[str]) -> str:
+    """A reason of the report as a sentence (:func:`words`, a capital, a full stop)."""
+    text = words(text, labels)
     return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
 
 
@@ -98,9 +101,12 @@ def test_text(report: dict) -> str | None:
     if not test.get("test"):
         return None
     sigma = test.get("separation_sigma")
-    return (f"Test that would decide: {plain(test['test'], labels)[:-1]}"
-            + (f"; the two leading explanations differ there by {sigma:.3g} σ "
-               "(of the repeatability floor)." if sigma is not None else "."))
+    leaders = report.get("decision", {}).get("leaders") or []
+    who = (" and ".join(candidate_text(x) for x in leaders) if len(leaders) == 2
+           else "the two leading explanations")
+    return (f"Test that would decide: {words(test['test'], labels)}"
+            + (f"; {who} differ there by {sigma:.3g} σ (of the repeatability floor)."
+               if sigma is not None else "."))
 
 
 def _untestable_notes(report: dict) -> list[Note]:

@@ -13,7 +13,8 @@ from types import SimpleNamespace
 import pytest
 
 from campaign_report.figures import gap_heatmap
-from campaign_report.gap import candidate_text, gap_page, gap_section, plain, write_gap_page
+from campaign_report.gap import (_folds_text, candidate_text, gap_page, gap_section, plain,
+                                 test_text, write_gap_page)
 from campaign_report.html import Heading, Image, render_page
 from campaign_report.style import EFFECTS, PARAMETERS, value_text
 from sim_gap.candidates import EFFECT_PARAMS, soil_params
@@ -189,6 +190,17 @@ def test_plain_words_and_display_units():
                  "(40 % of the held-out loss)", ["slip_sinkage+grousers"]) == (
         "Slip sinkage + grousers improves on soil-only recalibration by only 3.1 standard "
         "errors (40 % of the held-out loss).")
+    two = {"candidates": [], "decision": {"leaders": ["grousers", "slip_sinkage"]},
+           "separating_test": {
+        "test": "test at another gravity (3.71 m/s^2, gravity-offload rig or parabolic flight)",
+        "separation_sigma": 5.25}}
+    assert test_text(two) == ("Test that would decide: test at another gravity (3.71 m/s², "
+                              "gravity-offload rig or parabolic flight); grousers and slip "
+                              "sinkage differ there by 5.25 σ (of the repeatability floor).")
+    assert _folds_text(["load=70", "load=120", "multipass=0", "multipass=1", "multipass=2"]) \
+        == "each load (70 N, 120 N); each multipass (0, 1, 2)"
+    assert _folds_text(["slip band 0", "slip band 4"]) == \
+        "each slip band (-100 to 0 %, 60 to 100 %)"
     # 1.8e7 N/m^(n+2) = 18 000 kN/m^(n+2); K 0.0096 m = 9.6 mm; 30e3 N/m = 30 kN/m
     assert value_text(PARAMETERS["soil.kphi"], 1.8e7) == "18000 kN/m^(n+2)"
     assert value_text(PARAMETERS["soil.shear_modulus_m"], 0.0096) == "9.6 mm"
