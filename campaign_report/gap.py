@@ -189,8 +189,8 @@ def _how_far_blocks(report: dict) -> list[Block]:
     per = report["shrink"]["per_quantity"]
     chosen = candidate_text(report["chosen"])
     keys = list(per)
-    rmse = [[f"before: {SOIL_ONLY_TEXT}"] + [_number(QUANTITIES[k], per[k]["before"])
-                                             for k in keys]]
+    first = SOIL_ONLY_TEXT if report["chosen"] == SOIL_ONLY else f"before: {SOIL_ONLY_TEXT}"
+    rmse = [[first] + [_number(QUANTITIES[k], per[k]["before"]) for k in keys]]
     if report["chosen"] != SOIL_ONLY:
         rmse.append([f"after: {chosen}"] + [_number(QUANTITIES[k], per[k]["after"])
                                             for k in keys])
