@@ -30,6 +30,8 @@ from traceability.models import GapReport
 from traceability.provenance import swtlab_version
 
 CANDIDATES_SHOWN = 8
+#: rows of a significant-regions table (the strongest; the heatmap shows every region)
+REGIONS_SHOWN = 12
 NAME = "gap"
 SOIL_ONLY = "soil_only"
 SOIL_ONLY_TEXT = "soil recalibration only"
@@ -115,19 +117,32 @@ def _untestable_notes(report: dict) -> list[Note]:
             for effect, why in report["untestable_effects"].items()]
 
 
+def _key(region: dict) -> tuple:
+    return region["slip_band"], region["load_n"], region["multipass"], region["gravity_mps2"]
+
+
+def significant_regions(regions: list[dict], tag: str) -> list[tuple]:
+    """Keys of the regions with a significant cell, at most :data:`REGIONS_SHOWN`: those
+    with the largest significant |z|."""
+    strongest: dict[tuple, float] = {}
+    for r in regions:
+        if r[f"significant{tag}"]:
+            strongest[_key(r)] = max(strongest.get(_key(r), 0.0), abs(r[f"z{tag}"]))
+    return sorted(strongest, key=strongest.get, reverse=True)[:REGIONS_SHOWN]
+
+
 def _regions_table(report: dict, tag: str) -> Table | None:
-    """Regions with a significant residual: their conditions and each quantity's mean
-    residual in its unit (``*``: significant); None when none is significant."""
+    """Regions with a significant residual (the strongest :data:`REGIONS_SHOWN`): their
+    conditions and each quantity's mean residual in its unit (``*``: significant); None
+    when none is significant."""
     regions = report["regions"]
-    hits = {(r["slip_band"], r["load_n"], r["multipass"], r["gravity_mps2"])
-            for r in regions if r[f"significant{tag}"]}
+    hits = set(significant_regions(regions, tag))
     if not hits:
         return None
     quantities = list(dict.fromkeys(r["quantity"] for r in regions))
     cells: dict[tuple, dict[str, str]] = {}
     for r in regions:
-        key = (r["slip_band"], r["load_n"], r["multipass"], r["gravity_mps2"])
-        if key in hits:
+        if (key := _key(r)) in hits:
             q = QUANTITIES[r["quantity"]]
             cells.setdefault(key, {})[r["quantity"]] = (
                 f"{r[f'mean_residual{tag}'] * q.scale:+.3g}"
@@ -153,17 +168,23 @@ def _where_blocks(report: dict) -> list[Block]:
     for tag, what in (("", "the simulation as given"),
                       ("_soil_recalibrated", "the simulation after soil-only recalibration")):
         n_sig = sum(r[f"significant{tag}"] for r in regions)
+        n_keys = len({_key(r) for r in regions if r[f"significant{tag}"]})
         blocks.append(Image(f"gap-heatmap{tag.replace('_', '-')}",
                             f"Residual map of {what}: mean residual per slip band and "
                             "condition, in % of the wheel load (torque: of load × radius; "
                             "sinkage: of the wheel radius); * significant",
                             to_png(gap_heatmap(regions, tag))[0]))
         table = _regions_table(report, tag)
+        listed = "."
+        if table is not None:
+            which = ("listed below" if n_keys == len(table.rows) else
+                     f"below the {len(table.rows)} of their {n_keys} regions with the largest "
+                     "residual in σ")
+            listed = f": {which}, * marks the significant quantities."
         blocks.append(Note(f"{n_sig} of {len(regions)} region-quantity cells differ "
                            f"significantly for {what} (chi-square test of the standardised "
                            "residuals, Benjamini-Hochberg at a 5 % false discovery rate)"
-                           + (": listed below, * marks the significant quantity."
-                              if table else ".")))
+                           + listed))
         if table:
             blocks.append(table)
     return blocks

@@ -14,7 +14,7 @@ import pytest
 
 from campaign_report.figures import gap_heatmap
 from campaign_report.gap import (_folds_text, candidate_text, gap_page, gap_section, plain,
-                                 test_text, write_gap_page)
+                                 significant_regions, test_text, write_gap_page)
 from campaign_report.html import Heading, Image, render_page
 from campaign_report.style import EFFECTS, PARAMETERS, value_text
 from sim_gap.candidates import EFFECT_PARAMS, soil_params
@@ -220,3 +220,13 @@ def test_gap_page_opens_in_chromium_and_every_image_decodes(report, tmp_path):
     found, console = probe(page, tmp_path)
     assert found["images"] == 2 and found["decoded"] == ["ok", "ok"]
     assert found["faults"] == [] and console == []
+
+
+def test_significant_regions_keeps_the_strongest_twelve():
+    """20 regions, drawbar pull at |z| = 0.5 and sinkage at |z| = region index in each, every
+    cell with z != 0 significant: kept are the regions of largest |z|, 19 down to 8."""
+    regions = [{"slip_band": "[0.0,0.2)", "load_n": float(i), "multipass": 0,
+                "gravity_mps2": 9.807, "quantity": q, "z": z, "significant": z != 0}
+               for i in range(20) for q, z in (("dp_n", 0.5), ("sinkage_m", -float(i)))]
+    keys = significant_regions(regions, "")
+    assert [k[1] for k in keys] == [float(i) for i in range(19, 7, -1)]
