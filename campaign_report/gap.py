@@ -200,7 +200,7 @@ def _which_blocks(report: dict) -> list[Block]:
                  f"with {_folds_text(report['folds'])} held out in turn, and is scored by the "
                  "RMS of its held-out residuals in units of their uncertainty (σ: standard "
                  "error and repeatability floor); the difference from the best is a paired "
-                 "z over runs." + (f" {more} more in the JSON." if more > 0 else "")),
+                 "z over runs." + (f" {more} more explanations in the JSON report." if more > 0 else "")),
             Table(["rank", "explanation", "held-out RMS residual [σ]",
                    "difference from the best [standard errors]", "free parameters",
                    "fitted values (all data)"], rows, numeric=frozenset({0, 2, 3, 4}))]
@@ -230,7 +230,28 @@ def _how_far_blocks(report: dict) -> list[Block]:
                 for k in keys]
         blocks.append(Table(["quantity", "shrink [%]", "shrink 95 % interval [%]"], rows,
                             numeric=frozenset({1, 2})))
-    return blocks
+    return blocks + _per_band_blocks(report, keys)
+
+
+def _per_band_blocks(report: dict, keys: list[str]) -> list[Block]:
+    """Held-out RMSE per slip band: where the gap remains (before → after with an effect)."""
+    bands = report["shrink"]["per_slip_band"]
+    if not bands:
+        return []
+    arrow = report["chosen"] != SOIL_ONLY
+    rows = []
+    for band, per in bands.items():
+        cells = []
+        for k in keys:
+            v, q = per.get(k, {}), QUANTITIES[k]
+            before, after = _number(q, v.get("before")), _number(q, v.get("after"))
+            cells.append(f"{before} → {after}" if arrow and before else before)
+        rows.append([slip_band_text(band)] + cells)
+    what = (f"before → after ({SOIL_ONLY_TEXT} → {candidate_text(report['chosen'])})" if arrow
+            else SOIL_ONLY_TEXT)
+    return [Note(f"Held-out RMSE per slip band, {what}: where the gap remains."),
+            Table(["slip band [%]"] + [QUANTITIES[k].axis_label for k in keys], rows,
+                  numeric=frozenset(range(1, len(keys) + 1)))]
 
 
 def _number(quantity, si_value: float | None) -> str:
