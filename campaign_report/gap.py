@@ -83,7 +83,7 @@ def _residual_text(quantity: str, si_value: float) -> str:
     return f"{'+' if si_value > 0 else ''}{value_text(QUANTITIES[quantity], si_value)}"
 
 
-def test_text(report: dict) -> str | None:
+def decisive_test_text(report: dict) -> str | None:
     """The test that would decide (or, for an unexplained gap, where it is largest)."""
     test = report.get("separating_test")
     if not test:
@@ -195,12 +195,13 @@ def _which_blocks(report: dict) -> list[Block]:
              f"{c['z_vs_best']:.3g}", str(c["n_params"]), _parameters_text(c["parameters"])]
             for i, c in enumerate(report["candidates"][:CANDIDATES_SHOWN])]
     more = len(report["candidates"]) - CANDIDATES_SHOWN
+    rest = f" {more} more explanations in the JSON report." if more > 0 else ""
     return [Heading("Which: explanations ranked by their held-out score"),
             Note("Each explanation frees the soil and the strength of its effects, is fitted "
                  f"with {_folds_text(report['folds'])} held out in turn, and is scored by the "
                  "RMS of its held-out residuals in units of their uncertainty (σ: standard "
                  "error and repeatability floor); the difference from the best is a paired "
-                 "z over runs." + (f" {more} more explanations in the JSON report." if more > 0 else "")),
+                 "z over runs." + rest),
             Table(["rank", "explanation", "held-out RMS residual [σ]",
                    "difference from the best [standard errors]", "free parameters",
                    "fitted values (all data)"], rows, numeric=frozenset({0, 2, 3, 4}))]
@@ -285,7 +286,7 @@ def gap_blocks(report: dict) -> list[Block]:
     blocks: list[Block] = [Heading(f"Verdict: {verdict_text(report['verdict'])}"),
                            Note(plain(report["reason"], labels),
                                 warning=report["verdict"] == "inconclusive")]
-    if (test := test_text(report)) is not None:
+    if (test := decisive_test_text(report)) is not None:
         blocks.append(Note(test))
     blocks += _untestable_notes(report)
     return blocks + _where_blocks(report) + _which_blocks(report) + _how_far_blocks(report)

@@ -13,8 +13,8 @@ from types import SimpleNamespace
 import pytest
 
 from campaign_report.figures import gap_heatmap
-from campaign_report.gap import (_folds_text, candidate_text, gap_page, gap_section, plain,
-                                 significant_regions, test_text, write_gap_page)
+from campaign_report.gap import (_folds_text, candidate_text, decisive_test_text, gap_page,
+                                 gap_section, plain, significant_regions, write_gap_page)
 from campaign_report.html import Heading, Image, render_page
 from campaign_report.style import EFFECTS, PARAMETERS, value_text
 from sim_gap.candidates import EFFECT_PARAMS, soil_params
@@ -121,6 +121,9 @@ def test_gap_page_reads_as_plain_words_with_units(report, tmp_path):
     assert f"k_φ (frictional modulus) = {sig3(best['soil.kphi'] / 1000)} kN/m^(n+2)" in text
     assert f"K (shear deformation modulus) = {sig3(best['soil.shear_modulus_m'] * 1000)} mm" \
         in text
+    # hidden slip sinkage: significant regions against the simulation as given, tabled
+    assert any(r["significant"] for r in report["regions"])
+    assert any("load [N]" in t["header"] for t in page.tables)
     # the held-out RMSE table: drawbar pull before, in N
     (rmse,) = [t for t in page.tables if t["header"][0] == "held-out RMSE"]
     assert rmse["header"][1:] == ["drawbar pull [N]", "torque [N·m]", "sinkage [mm]",
@@ -146,7 +149,7 @@ def test_no_empty_table_and_region_sentence(report):
                                     "slip_band", "load_n", "multipass", "gravity_mps2",
                                     "quantity")}}
     page = check_page(render_page(gap_page(quiet)))
-    assert [t for t in page.tables if "slip band [%]" in t["header"]] == []
+    assert [t for t in page.tables if "load [N]" in t["header"]] == []  # no regions table
     text = " ".join(page.text)
     assert "0 of" in text and "differ significantly" in text
     assert ("misses most in drawbar pull at slips 20 to 40 %, "
@@ -194,9 +197,10 @@ def test_plain_words_and_display_units():
            "separating_test": {
         "test": "test at another gravity (3.71 m/s^2, gravity-offload rig or parabolic flight)",
         "separation_sigma": 5.25}}
-    assert test_text(two) == ("Test that would decide: test at another gravity (3.71 m/s², "
-                              "gravity-offload rig or parabolic flight); grousers and slip "
-                              "sinkage differ there by 5.25 σ (of the repeatability floor).")
+    assert decisive_test_text(two) == (
+        "Test that would decide: test at another gravity (3.71 m/s², gravity-offload rig or "
+        "parabolic flight); grousers and slip sinkage differ there by 5.25 σ (of the "
+        "repeatability floor).")
     assert _folds_text(["load=70", "load=120", "multipass=0", "multipass=1", "multipass=2"]) \
         == "each load (70 N, 120 N); each multipass (0, 1, 2)"
     assert _folds_text(["slip band 0", "slip band 4"]) == \
