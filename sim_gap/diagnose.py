@@ -23,7 +23,7 @@ TESTABLE_SIGMA = 0.2
 #: what each effect needs from a campaign to show (for the untestable list)
 CONTRAST_NEEDED = {"multipass": "a second multipass level",
                    "reduced_gravity": "a gravity level other than the reference 9.81 m/s^2",
-                   "grousers": "a wheel with grousers (grouser_count, grouser_height_m > 0)",
+                   "grousers": "a wheel with grousers (a grouser count and height in the model)",
                    "slip_sinkage": "several slips", "wheel_flexibility": "a flexible wheel",
                    "bulldozing": "measurable sinkage"}
 
@@ -55,7 +55,8 @@ def testable(sim: Simulated, points: pd.DataFrame, effects: list[str]
         if change >= TESTABLE_SIGMA:
             keep.append(name)
         else:
-            dropped[name] = f"no effect at these conditions; needs {CONTRAST_NEEDED[name]}"
+            dropped[name] = (f"it changes no prediction at these conditions; the campaign "
+                             f"needs {CONTRAST_NEEDED[name]}")
     return keep, dropped
 
 

@@ -48,9 +48,12 @@ def run(args: argparse.Namespace) -> int:
                   file=sys.stderr)
             return exit_codes.USAGE
     try:
-        report = run_gap(args.measured, args.sim, args.json, args.html, effects,
-                         args.reference_model,
+        report = run_gap(args.measured, args.sim, args.json, effects, args.reference_model,
                          Settings(n_boot=args.boot, jobs=args.jobs, seed=args.seed))
+        if args.html:
+            from campaign_report.gap import write_gap_page
+
+            write_gap_page(report, args.html)
     except (OSError, ValueError, KeyError) as exc:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
