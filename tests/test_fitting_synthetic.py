@@ -11,7 +11,11 @@ import pytest
 
 from terramechanics import shipped_model
 
-TESTED_SLIPS = (-0.10, 0.0, 0.05, 0.10, 0.20, 0.35, 0.60)  # 0.90: no stable phase (dig-in)
+# The sample campaign's multipass-0 slips: speed control at -10 ... 60 % (90 %: no stable
+# phase, dig-in), the towed run (about -5.7 %) and the free-sled run (about 3 %). The towed
+# run is the second point on the braked side: a braked branch (Wong & Reece 1967 part II,
+# fitted with its own step and slope, docs/fitting.md) is undetermined by one point alone.
+TESTED_SLIPS = (-0.10, -0.057, 0.0, 0.03, 0.05, 0.10, 0.20, 0.35, 0.60)
 VALIDATION_SLIPS = (-0.05, 0.03, 0.15, 0.45, 0.75)
 TESTED_LOADS_N = (70.0, 180.0, 300.0)
 MODEL = shipped_model("bb2_sand")
