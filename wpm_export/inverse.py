@@ -133,6 +133,6 @@ def solve_slip(coefficients, row, target, slip_min: float, slip_max: float,
         found = _root(shifted, g[pick, first], g[pick, first + 1])
         slip[idx], value[idx] = found, horner(shifted, found) + t
         jump = ((first == n_braked - 1) & (len(sides) == 2)
-                & (d[pick, first] != d[pick, first + 1]))
+                & (d[pick, first] * d[pick, first + 1] < 0))  # strictly inside the jump
         slip[idx[jump]], value[idx[jump]], status[idx[jump]] = 0.0, t[jump], STATUS_STEP
     return SlipSolution(slip=slip, value=value, status=status.astype(str))
