@@ -58,14 +58,20 @@ def curve_value(coefficients, slip, step_below_zero=0.0, slope_below_zero=0.0) -
     return horner(coefficients, s) + np.where(s < 0, step + slope * s, 0.0)
 
 
+def _braked_span(slip_min: float) -> float:
+    """Width of the braked side of the slip range (1 where there is none: unused)."""
+    return -slip_min if slip_min < 0 else 1.0
+
+
 def branch_design(slip, slip_min: float, slip_max: float, degree: int,
                   branch: int) -> np.ndarray:
     """Design matrix: Chebyshev-Vandermonde columns on the scaled interval, then the first
     ``branch`` of the braked-branch columns ``[slip < 0]``, ``x [slip < 0]`` with ``x`` the
-    slip scaled as the Chebyshev argument is (``2 slip / (slip_max - slip_min)``)."""
+    slip over the braked span (``slip / -slip_min``: -1 ... 0), for a well-conditioned
+    matrix."""
     s = np.asarray(slip, dtype=float)
     below = (s < 0).astype(float)
-    columns = [below, below * s * 2.0 / (slip_max - slip_min)][:branch]
+    columns = [below, below * s / _braked_span(slip_min)][:branch]
     return np.column_stack([chebyshev.chebvander(scaled_slip(s, slip_min, slip_max), degree),
                             *columns])
 
@@ -79,7 +85,7 @@ def branch_from_solution(solution, slip_min: float, slip_max: float,
     branch = np.zeros(solution.shape[:-1] + (2,))
     terms = solution[..., degree + 1:]
     branch[..., :terms.shape[-1]] = terms
-    branch[..., 1] *= 2.0 / (slip_max - slip_min)
+    branch[..., 1] /= _braked_span(slip_min)
     return coefficients, branch
 
 
@@ -137,7 +143,7 @@ def weighted_lstsq(slip, value, weights, degree: int, slip_min: float,
                                                degree)
     factor = np.sqrt(np.sum(np.linalg.inv(r)[degree + 1:] ** 2, axis=1))  # (R^T R)^-1 diagonal
     se = np.full(2, np.nan)
-    se[:branch] = factor * np.array([1.0, 2.0 / (slip_max - slip_min)])[:branch]
+    se[:branch] = factor * np.array([1.0, 1.0 / _braked_span(slip_min)])[:branch]
     singular = np.linalg.svd(r, compute_uv=False)
     return LeastSquares(coefficients=coefficients, branch=branch, below_zero=below,
                         below_zero_se=se, fitted=curve_value(coefficients, slip, *below),

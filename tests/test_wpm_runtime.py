@@ -62,7 +62,7 @@ def test_targets_inside_the_jump_at_zero_slip_are_given_at_zero_slip():
                        load_n=100.0, quantity="dp_n", unit="N", n_points=9, rmse=0.0, line=3,
                        step_below_zero=-5.0, slope_below_zero=20.0)
     wpm = WheelPerformanceModule([stepped])
-    found = wpm.slip_for("dp_n", [-17.0, -4.0, -2.5, -1.0, 30.0, -29.0, 61.0], 100.0)
+    found = wpm.slip_for("dp_n", [-17.0, -4.0, -2.5, -1.0, 30.0, -30.0, 61.0], 100.0)
     np.testing.assert_allclose(found.slip[:5], [-0.1, 0.0, 0.0, 0.0, 0.3], atol=1e-12)
     assert found.status.tolist() == ["ok"] + ["at_step"] * 3 + ["ok", "below_min", "above_max"]
     assert found.reached.tolist() == [True] * 5 + [False] * 2
