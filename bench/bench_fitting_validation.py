@@ -24,10 +24,10 @@ from test_fitting_synthetic import model_results_table, sample_like_table  # noq
 QUANTITIES = ("dp_n", "torque_nm", "sinkage_m", "resistance_n", "dp_over_w")
 
 
-def _check(table, multipass: int = 0) -> dict:
+def _check(table, multipass: int = 0, **options) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return {r.quantity: r for r in validate_load_interpolation(table, 120.0)
+        return {r.quantity: r for r in validate_load_interpolation(table, 120.0, **options)
                 if r.multipass == multipass}
 
 
@@ -53,6 +53,11 @@ def main(quick: bool = False) -> dict:
               f"{truth[q].rmse_pct_of_range:15.2f}")
     out["choices_noise_free"] = sorted(f"{f.quantity}@{f.load_n:g}: {_choice(f)}" for f in fits)
     print("noise-free choices:", "; ".join(out["choices_noise_free"]))
+    for branch in (0, 1, 2):  # cubic, no noise: what each braked-branch form gives
+        forced = _check(sample_like_table(None), degree=3, branch=branch)
+        out[f"cubic_branch_{branch}_pct"] = {q: forced[q].rmse_pct_of_range for q in QUANTITIES}
+        print(f"cubic, {branch} branch terms, no noise: " + ", ".join(
+            f"{q} {forced[q].rmse_pct_of_range:.2f} %" for q in QUANTITIES))
     for criterion in ("loo", "aicc"):
         noisy_fits = [f for seed in draws
                       for f in fit_results(model_results_table(seed=seed), degree=criterion)]
