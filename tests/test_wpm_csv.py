@@ -170,4 +170,6 @@ def test_the_example_of_the_format_page_reads_and_evaluates_as_stated():
     example = page.split("```text\n", 1)[1].split("```", 1)[0]
     header, curves = parse_wpm_csv(example, "docs/wpm-csv.md")
     assert header["format"] == FORMAT and len(curves) == 4
-    assert curves[0].evaluate(0.2) == pytest.approx(12.63, abs=0.005)
+    assert curves[0].evaluate(0.2) == pytest.approx(13.11, abs=0.005)
+    assert curves[0].evaluate(-0.05) == pytest.approx(-7.52, abs=0.005)  # braked branch
+    assert (curves[3].step_below_zero, curves[3].slope_below_zero) == (0.0, 0.0)
