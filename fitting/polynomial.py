@@ -55,6 +55,8 @@ def curve_value(coefficients, slip, step_below_zero=0.0, slope_below_zero=0.0) -
     ``coefficients``, broadcast like them); zero slip belongs to the driven side."""
     s = np.asarray(slip, dtype=float)
     step, slope = (np.asarray(x, dtype=float) for x in (step_below_zero, slope_below_zero))
+    if not (step.any() or slope.any()):  # a plain polynomial: no branch to add
+        return horner(coefficients, s)
     return horner(coefficients, s) + np.where(s < 0, step + slope * s, 0.0)
 
 

@@ -14,7 +14,8 @@ its minimum gives slip NaN and the minimum (status ``below_min``).
 
 A curve with a braked branch (``[slip < 0] (J + K slip)``, docs/fitting.md) is two
 polynomials, braked below zero slip and driven from it, which jump at zero by ``-J``. Each
-side gets its own grid, the braked one ending at its limit at zero; the interval between the
+side gets its own grid (half the points each), the braked one ending at its limit at zero;
+the interval between the
 two sides' values at zero brackets the targets inside the jump, which the wheel gives at zero
 slip: slip 0.0, value the target, status ``at_step`` (counted as reached).
 """
@@ -84,11 +85,11 @@ def _extremes(coefficients: np.ndarray, grid: np.ndarray, values: np.ndarray) ->
     return np.stack(out, axis=1)
 
 
-def _side_grids(coefficients: np.ndarray, slip_min: float,
-                slip_max: float) -> tuple[np.ndarray, np.ndarray]:
-    """Each row's grid over one side of zero slip (``GRID_POINTS`` points, ends included) with
-    its extremes added, sorted, and the values there (rows x points)."""
-    base = np.linspace(slip_min, slip_max, GRID_POINTS)
+def _side_grids(coefficients: np.ndarray, slip_min: float, slip_max: float,
+                points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's grid over [slip_min, slip_max] (``points``, ends included) with its extremes
+    added, sorted, and the values there (rows x points)."""
+    base = np.linspace(slip_min, slip_max, points)
     base_values = horner(coefficients[:, None, :], base)
     grids = np.sort(np.concatenate([np.broadcast_to(base, (len(coefficients), base.size)),
                                     _extremes(coefficients, base, base_values)], axis=1), axis=1)
@@ -108,11 +109,14 @@ def solve_slip(coefficients, row, target, slip_min: float, slip_max: float,
     braked = coefficients.copy()
     if below_zero is not None:
         braked[:, :2] += np.asarray(below_zero, dtype=float)
-    sides = ([(braked, slip_min, min(slip_max, 0.0))] if slip_min < 0 else []) \
-        + ([(coefficients, max(slip_min, 0.0), slip_max)] if slip_max >= 0 else [])
-    parts = [_side_grids(c, lo, hi) for c, lo, hi in sides]
+    if slip_min < 0 <= slip_max and np.any(braked != coefficients):
+        sides = [(braked, slip_min, 0.0), (coefficients, 0.0, slip_max)]
+    else:  # one polynomial over the range (on one side of zero, or without a branch)
+        sides = [(braked if slip_max < 0 else coefficients, slip_min, slip_max)]
+    points = GRID_POINTS // len(sides) + 1
+    parts = [_side_grids(c, lo, hi, points) for c, lo, hi in sides]
     grids, values = (np.concatenate(x, axis=1) for x in zip(*parts))
-    n_braked = parts[0][0].shape[1] if slip_min < 0 else 0  # the jump: after the braked grid
+    n_braked = parts[0][0].shape[1] if len(sides) == 2 else 0  # the jump follows its last point
     top, bottom = values.max(axis=1), values.min(axis=1)
     slip, value = np.full(target.shape, np.nan), np.empty(target.shape)
     status = np.full(target.shape, STATUS_OK, dtype=object)
@@ -127,12 +131,10 @@ def solve_slip(coefficients, row, target, slip_min: float, slip_max: float,
         brackets = (np.sign(d[:, :-1]) != np.sign(d[:, 1:])) | (d[:, :-1] == 0)
         first = np.argmax(brackets, axis=1)
         pick = np.arange(idx.size)
-        on_braked = first < n_braked - 1
-        shifted = np.where(on_braked[:, None], braked[r], coefficients[r])
+        shifted = np.where((first < n_braked - 1)[:, None], braked[r], sides[-1][0][r])
         shifted[:, 0] -= t
         found = _root(shifted, g[pick, first], g[pick, first + 1])
         slip[idx], value[idx] = found, horner(shifted, found) + t
-        jump = ((first == n_braked - 1) & (len(sides) == 2)
-                & (d[pick, first] * d[pick, first + 1] < 0))  # strictly inside the jump
+        jump = (first == n_braked - 1) & (d[pick, first] * d[pick, first + 1] < 0)  # inside it
         slip[idx[jump]], value[idx[jump]], status[idx[jump]] = 0.0, t[jump], STATUS_STEP
     return SlipSolution(slip=slip, value=value, status=status.astype(str))
