@@ -102,9 +102,9 @@ class WheelPerformanceModule:
             curves, index = self._curves_at(q, load, selection, allow_extrapolation)
             if np.any((slip < curves.slip_min) | (slip > curves.slip_max)):
                 outside.append(f"{q} [{curves.slip_min:g}, {curves.slip_max:g}]")
-            below = curves.below_zero[index]
-            out[q] = curve_value(curves.coefficients[index], slip.ravel(), below[:, 0],
-                                 below[:, 1]).reshape(slip.shape)
+            step, slope = curves.below_zero[index].T if curves.below_zero.any() else (0.0, 0.0)
+            out[q] = curve_value(curves.coefficients[index], slip.ravel(), step,
+                                 slope).reshape(slip.shape)
         if outside:
             warnings.warn("slip outside the range of " + ", ".join(outside) + ": extrapolated",
                           OutsideSlipRangeWarning, stacklevel=2)
