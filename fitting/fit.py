@@ -7,7 +7,10 @@ fit is computed to obtain a continuous function. The degree ... can be specified
 run's mean. The braked branch ``[slip < 0] (J + K slip)``: Wong & Reece (1967) give the
 driven wheel (part I, J. Terramech. 4(1)) and the braked/towed wheel (part II,
 J. Terramech. 4(2)) different stress laws and slip definitions, which meet at zero slip with
-a jump and a change of slope that no polynomial follows (docs/fitting.md).
+a jump and a change of slope that no polynomial follows. Two terms rather than the step
+alone: on the model's noise-free 120 N check a cubic with the step alone still misses
+sinkage by 7.0 % and resistance by 10.8 % of their ranges (their braked sides slope the other
+way), with step and slope by 0.67 % and 0.69 % (docs/fitting.md, "The join at zero slip").
 """
 
 from __future__ import annotations
