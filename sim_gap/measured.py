@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from fitting.polynomial import horner
+from fitting.polynomial import curve_value
 from fitting.table import from_run_results
 from sim_gap.vocabulary import QUANTITIES
 from wpm_export import WheelPerformanceModule
@@ -74,7 +74,8 @@ def from_wpm(wpm: WheelPerformanceModule, gravity_mps2: float | None = None) -> 
                 row = {"run_id": f"{soil}/{wheel}/mp{mp}/{load:g}N/{i}", "load_set_n": load,
                        "load_n": load, "multipass": mp, "gravity_mps2": g, "slip": s}
                 for q, c in curves.items():
-                    row[q] = float(horner(c.coefficients, s))
+                    row[q] = float(curve_value(c.coefficients, s, c.step_below_zero,
+                                               c.slope_below_zero))
                     row[f"{q}_se"] = max(c.rmse, 1e-9)
                 rows.append(row)
     return _finish(pd.DataFrame(rows), wpm.source)

@@ -9,12 +9,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fitting.curve import DEGREES, PowerCurve
-from wpm_export.schema import COEFFICIENT_COLUMNS, COLUMNS, FORMAT, UNITS, WpmFormatError
+from wpm_export.schema import (BRANCH_COLUMNS, COEFFICIENT_COLUMNS, COLUMNS, FORMAT, UNITS,
+                               WpmFormatError)
 
 
 @dataclass(frozen=True)
 class WpmCurve(PowerCurve):
-    """One row of a WPM CSV: ``sum_i a_i slip**i`` on [slip_min, slip_max]."""
+    """One row of a WPM CSV: ``sum_i a_i slip**i + [slip < 0] (J + K slip)`` on
+    [slip_min, slip_max]."""
 
     soil: str
     wheel: str
@@ -44,11 +46,11 @@ def _integer(text: str, column: str, problem) -> int:
         raise problem(f"{column} {text!r} is not an integer") from None
 
 
-def _curve(fields: list[str], problem, line: int) -> WpmCurve:
-    """One data row -> curve, every rule of the page checked."""
-    if len(fields) != len(COLUMNS):
-        raise problem(f"{len(fields)} fields, the format has {len(COLUMNS)}")
-    row = dict(zip(COLUMNS, (f.strip() for f in fields)))
+def _curve(fields: list[str], problem, line: int, columns: tuple[str, ...]) -> WpmCurve:
+    """One data row -> curve, every rule of the page checked; ``columns``: the file's."""
+    if len(fields) != len(columns):
+        raise problem(f"{len(fields)} fields, the format has {len(columns)}")
+    row = dict(zip(columns, (f.strip() for f in fields)))
     if not row["soil"] or not row["wheel"]:
         raise problem("soil and wheel must not be empty")
     quantity = row["quantity"]
@@ -79,7 +81,9 @@ def _curve(fields: list[str], problem, line: int) -> WpmCurve:
     rmse = _number(row["rmse"], "rmse", problem)
     if rmse < 0:
         raise problem(f"rmse {rmse:g} < 0")
+    step, slope = (_number(row[c], c, problem) if c in row else 0.0 for c in BRANCH_COLUMNS)
     return WpmCurve(coefficients=coefficients, slip_min=slip_min, slip_max=slip_max,
+                    step_below_zero=step, slope_below_zero=slope,
                     soil=row["soil"], wheel=row["wheel"], multipass=multipass, load_n=load_n,
                     quantity=quantity, unit=row["unit"], n_points=n_points, rmse=rmse, line=line)
 
@@ -89,7 +93,7 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
     header: dict[str, str] = {}
     curves: list[WpmCurve] = []
     seen: dict[tuple, int] = {}
-    columns_line = 0
+    columns_line, columns = 0, COLUMNS
     for number, raw in enumerate(text.splitlines(), start=1):
         def problem(message: str, _n=number) -> WpmFormatError:
             return WpmFormatError(path, _n, message)
@@ -108,11 +112,13 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
                 raise problem(f"missing '# format: {FORMAT}' line before the column header"
                               if "format" not in header else
                               f"format {header['format']!r}, this reader reads {FORMAT!r}")
-            if tuple(f.strip() for f in next(csv.reader([raw]))) != COLUMNS:
-                raise problem(f"column header must be {','.join(COLUMNS)}")
+            columns = tuple(f.strip() for f in next(csv.reader([raw])))
+            if columns not in (COLUMNS + BRANCH_COLUMNS, COLUMNS):
+                raise problem(f"column header must be {','.join(COLUMNS + BRANCH_COLUMNS)} "
+                              f"(or without {', '.join(BRANCH_COLUMNS)})")
             columns_line = number
             continue
-        curve = _curve(next(csv.reader([raw])), problem, number)
+        curve = _curve(next(csv.reader([raw])), problem, number, columns)
         key = (curve.soil, curve.wheel, curve.multipass, curve.load_n, curve.quantity)
         if key in seen:
             raise problem(f"duplicate curve {key} (also line {seen[key]})")

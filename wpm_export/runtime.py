@@ -13,7 +13,7 @@ import numpy as np
 
 from fitting.errors import OutsideSlipRangeWarning
 from fitting.load_interp import InterpolatedCurve, LoadCurves, interpolate_loads
-from fitting.polynomial import horner
+from fitting.polynomial import curve_value
 from wpm_export.inverse import SlipSolution, solve_slip
 from wpm_export.reader import WpmCurve, read_wpm_csv
 from wpm_export.schema import UNITS, WpmSelectionError
@@ -102,7 +102,9 @@ class WheelPerformanceModule:
             curves, index = self._curves_at(q, load, selection, allow_extrapolation)
             if np.any((slip < curves.slip_min) | (slip > curves.slip_max)):
                 outside.append(f"{q} [{curves.slip_min:g}, {curves.slip_max:g}]")
-            out[q] = horner(curves.coefficients[index], slip.ravel()).reshape(slip.shape)
+            step, slope = curves.below_zero[index].T if curves.below_zero.any() else (0.0, 0.0)
+            out[q] = curve_value(curves.coefficients[index], slip.ravel(), step,
+                                 slope).reshape(slip.shape)
         if outside:
             warnings.warn("slip outside the range of " + ", ".join(outside) + ": extrapolated",
                           OutsideSlipRangeWarning, stacklevel=2)
@@ -111,14 +113,15 @@ class WheelPerformanceModule:
     def slip_for(self, quantity: str, target, load_n, *, soil=None, wheel=None, multipass=None,
                  allow_extrapolation: bool = False) -> SlipSolution:
         """The smallest slip at which the wheel gives ``target`` of ``quantity`` at ``load_n``
-        (broadcast together); slip 1.0 and the maximum where the target is above the curve
+        (broadcast together); slip 1.0 and the maximum where the target is above the curve,
+        slip 0.0 and status ``at_step`` where it falls inside the jump at zero slip
         (:mod:`wpm_export.inverse`)."""
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
         target, load = np.broadcast_arrays(np.asarray(target, dtype=float),
                                            np.asarray(load_n, dtype=float))
         curves, index = self._curves_at(quantity, load, selection, allow_extrapolation)
         found = solve_slip(curves.coefficients, index, target.ravel(), curves.slip_min,
-                           curves.slip_max)
+                           curves.slip_max, curves.below_zero)
         shape = target.shape
         return SlipSolution(slip=found.slip.reshape(shape), value=found.value.reshape(shape),
                             status=found.status.reshape(shape))

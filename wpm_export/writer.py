@@ -13,7 +13,7 @@ import pandas as pd
 from fitting.curve import CurveFit
 from fitting.table import KEY_COLUMNS, MEASURED
 from wpm_export.reader import parse_wpm_csv
-from wpm_export.schema import COLUMNS, FORMAT, MAX_DEGREE, UNITS
+from wpm_export.schema import BRANCH_COLUMNS, COLUMNS, FORMAT, MAX_DEGREE, UNITS
 
 #: the columns of a results table the fits read, in the order they are hashed
 HASHED_COLUMNS = (KEY_COLUMNS + ("slip", "slip_se", "wheel_load_n", "wheel_load_n_se")
@@ -52,7 +52,8 @@ def _row(fit: CurveFit) -> list[str]:
     return [fit.soil, fit.wheel, str(int(fit.multipass)), repr(float(fit.load_n)), fit.quantity,
             UNITS[fit.quantity], str(fit.degree), repr(float(fit.slip_min)),
             repr(float(fit.slip_max)), *coefficients, *[""] * (MAX_DEGREE + 1 - len(coefficients)),
-            str(int(fit.n_points)), repr(float(fit.rmse))]
+            str(int(fit.n_points)), repr(float(fit.rmse)),
+            repr(float(fit.step_below_zero)), repr(float(fit.slope_below_zero))]
 
 
 def wpm_csv_text(fits: Iterable[CurveFit], inputs_sha256: str, swtlab_version: str,
@@ -68,7 +69,7 @@ def wpm_csv_text(fits: Iterable[CurveFit], inputs_sha256: str, swtlab_version: s
     if created:
         out.write(f"# created: {created}\n")
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(COLUMNS)
+    writer.writerow(COLUMNS + BRANCH_COLUMNS)
     writer.writerows(_row(f) for f in rows)
     parse_wpm_csv(out.getvalue(), "<WPM CSV being written>")
     return out.getvalue()
