@@ -57,7 +57,15 @@ PARAMETERS = {
     "effects.wheel_flexibility.hysteresis_coefficient": Quantity(
         "μ_h (hysteresis resistance / load)", "-"),
     "effects.multipass.stiffness_gain_per_pass": Quantity("soil stiffness gain per pass", "-"),
-    "effects.bulldozing.coefficient": Quantity("bulldozing factor (1 = Bekker's formula)", "-"),
+    "effects.bulldozing.coefficient": Quantity("bulldozing factor (1 = the law as published)",
+                                               "-"),
+    "effects.grousers.lug_sinkage_gain": Quantity("κ (lug-induced sinkage gain)", "-"),
+    "effects.slip_sinkage.coefficient": Quantity("κ (exponent on Lyasko's slip-sinkage factor)",
+                                                 "-"),
+    "effects.wheel_flexibility.ground_pressure_pa": Quantity("p_g (wheel ground pressure)", "kPa",
+                                                             1e-3),
+    "effects.multipass.elastic_stiffness_pa_m": Quantity("K_e (rut reloading stiffness)",
+                                                         "MPa/m", 1e-6),
 }
 #: the effects of the built-in model (terramechanics.EFFECTS) in plain words
 EFFECTS = {"grousers": "grousers", "slip_sinkage": "slip sinkage",

@@ -17,7 +17,8 @@ from campaign_report.gap import (_folds_text, candidate_text, decisive_test_text
                                  gap_section, plain, significant_regions, write_gap_page)
 from campaign_report.html import Heading, Image, render_page
 from campaign_report.style import EFFECTS, PARAMETERS, value_text
-from sim_gap.candidates import EFFECT_PARAMS, soil_params
+import terramechanics as tm
+from sim_gap.candidates import effect_params, soil_params
 from sim_gap.diagnose import diagnose
 from sim_gap.report import build_report
 from sim_gap.simulated import Simulated
@@ -211,11 +212,12 @@ def test_plain_words_and_display_units():
     assert value_text(PARAMETERS["effects.wheel_flexibility.radial_stiffness_n_m"],
                       3e4) == "30 kN/m"
     assert value_text(PARAMETERS["soil.friction_angle_deg"], 36.604) == "36.6°"
-    # every parameter a candidate can free, and every effect, has a plain name
-    fitted = {p.name for p in soil_params(BASE)} | {f"effects.{e}.{p[0]}"
-                                                    for e, ps in EFFECT_PARAMS.items()
-                                                    for p in ps}
-    assert fitted <= set(PARAMETERS) and set(EFFECT_PARAMS) <= set(EFFECTS)
+    # every parameter a candidate can free (each law of each effect), and every effect, has a
+    # plain name
+    fitted = {p.name for p in soil_params(BASE)} | {
+        p.name for effect, laws in tm.LAWS.items() for law in laws
+        for p in effect_params(effect, law)}
+    assert fitted - set(PARAMETERS) == set() and set(tm.LAWS) <= set(EFFECTS)
 
 
 @pytest.mark.skipif(CHROMIUM is None, reason="chromium not installed (.ci/chromium.sh)")
