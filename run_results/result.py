@@ -7,8 +7,7 @@ from dataclasses import dataclass, field
 from run_results.stats import QuantityStats
 from stable_phase import StableWindow
 from plain_json import jsonable
-
-STATUSES = ("ok", "flagged", "no_stable_phase")
+from swtlab.domain.results import STATUSES
 
 
 @dataclass(frozen=True)

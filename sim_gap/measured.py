@@ -18,9 +18,9 @@ import pandas as pd
 from fitting.polynomial import horner
 from fitting.table import from_run_results
 from sim_gap.vocabulary import QUANTITIES
+from swtlab.domain.gravity import G0_MPS2
 from wpm_export import WheelPerformanceModule
 
-STANDARD_GRAVITY_MPS2 = 9.80665
 #: slip grid on which WPM curves are sampled (inside each curve's range)
 WPM_SLIP_POINTS = 9
 
@@ -43,7 +43,7 @@ def from_results_table(results: pd.DataFrame, source: str = "results") -> pd.Dat
     table = table.dropna(subset=["slip"])
     table = table.assign(load_set_n=table["load_n"].astype(float),
                          load_n=table.get("wheel_load_n", table["load_n"]).astype(float),
-                         gravity_mps2=table["gravity_mps2"].fillna(STANDARD_GRAVITY_MPS2))
+                         gravity_mps2=table["gravity_mps2"].fillna(G0_MPS2))
     if table.empty:
         raise ValueError(f"{source}: no processed run with status ok")
     return _finish(table, source)
@@ -62,7 +62,7 @@ def from_wpm(wpm: WheelPerformanceModule, gravity_mps2: float | None = None) -> 
     """Points sampled from WPM curves: each (soil, wheel, multipass, load) curve set at
     :data:`WPM_SLIP_POINTS` slips over its range; the curve's RMSE is the uncertainty.
     Gravity: ``gravity_mps2``, else the header key ``gravity_mps2``, else standard."""
-    g = gravity_mps2 or float(wpm.header.get("gravity_mps2", STANDARD_GRAVITY_MPS2))
+    g = gravity_mps2 or float(wpm.header.get("gravity_mps2", G0_MPS2))
     rows = []
     for soil, wheel, mp in wpm.sets():
         by_q = wpm._sets[(soil, wheel, mp)]  # noqa: SLF001 - the reader's own index
@@ -95,7 +95,7 @@ def from_cmu_smooth_runs(path: str | Path) -> pd.DataFrame:
     raw = raw[raw["slip_angle_deg"] == 0].reset_index(drop=True)
     table = pd.DataFrame({
         "run_id": raw["run_file"].astype(str), "load_set_n": raw["wheel_load_n"].mean(),
-        "load_n": raw["wheel_load_n"], "multipass": 0, "gravity_mps2": STANDARD_GRAVITY_MPS2,
+        "load_n": raw["wheel_load_n"], "multipass": 0, "gravity_mps2": G0_MPS2,
         "slip": raw["slip"], "dp_n": raw["tractive_force_n"],
         "dp_n_se": raw["tractive_force_std_n"], "sinkage_m": -raw["hub_z_mm"] / 1000.0,
         "sinkage_m_se": np.maximum(raw["hub_z_std_mm"] / 1000.0, 1e-5)})

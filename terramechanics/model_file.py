@@ -84,7 +84,9 @@ def model_to_dict(model: WheelModel) -> dict:
         on = name in model.effects
         effects[name] = {"enabled": on, **dataclasses.asdict(model.effects.get(name) or cls())}
     return {"model": {"gravity_mps2": model.gravity_mps2},
-            "wheel": dataclasses.asdict(model.wheel), "soil": dataclasses.asdict(model.soil),
+            "wheel": {k: v for k, v in dataclasses.asdict(model.wheel).items()
+                      if v is not None and v != ""},
+            "soil": dataclasses.asdict(model.soil),
             "effects": effects}
 
 
