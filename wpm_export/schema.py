@@ -10,6 +10,9 @@ COEFFICIENT_COLUMNS = tuple(f"a{i}" for i in range(MAX_DEGREE + 1))
 COLUMNS = (("soil", "wheel", "multipass", "load_n", "quantity", "unit", "degree", "slip_min",
             "slip_max") + COEFFICIENT_COLUMNS + ("n_points", "rmse"))
 UNITS = QUANTITY_UNITS  # dp_n N, torque_nm N*m, sinkage_m m, resistance_n N, dp_over_w 1
+#: header key of the wheels' geometry (JSON: name -> WHEEL_KEYS)
+WHEEL_GEOMETRY_KEY = "wheel_geometry"
+WHEEL_KEYS = ("radius_m", "width_m", "grouser_count", "grouser_height_m", "stiffness_n_per_mm")
 
 
 class WpmFormatError(ValueError):
