@@ -10,7 +10,7 @@ Layout of the work folder::
     labels/labels.json            hidden effect sets and strengths (only the scorer reads it)
     labels/c000/truth/...         the testbed's per-run truth, moved out of the campaign
 
-Each campaign: loads x slips x multipass {0, 1} x gravity {9.81, 3.71}, so that every effect
+Each campaign: loads x slips x multipass {0, 1} x gravity {g0, Mars}, so that every effect
 has the contrast it needs (docs/gap-report.md, "Identifiability").
 """
 
