@@ -46,12 +46,14 @@ class ProcessedRun:
 class Campaign:
     """A processed campaign: ``runs`` (:class:`ProcessedRun`), ``results`` (one row per run in
     the schema of :mod:`swtlab.domain.results`, docs/results.md), ``failures`` (every run or
-    part of one that failed, with file, stage and reason) and the processing ``parameters``."""
+    part of one that failed, with file, stage and reason), the processing ``parameters`` and
+    the ``source`` database URL of a campaign loaded from one."""
 
     runs: list[ProcessedRun]
     results: pd.DataFrame
     failures: list[Failure]
     parameters: dict = field(default_factory=dict)
+    source: str | None = None
 
     def __post_init__(self) -> None:
         check_results(self.results)

@@ -74,4 +74,4 @@ def load(db_url: str, campaign: str | None = None) -> Campaign:
         table = table[table["campaign"] == campaign].reset_index(drop=True)
     runs = [ProcessedRun(path=Path(p), sha256=s)
             for p, s in zip(table.get("raw_file_path", []), table.get("raw_file_sha256", []))]
-    return Campaign(runs=runs, results=table, failures=failures)
+    return Campaign(runs=runs, results=table, failures=failures, source=db_url)
