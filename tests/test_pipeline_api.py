@@ -115,6 +115,15 @@ def test_fit_curves_follow_the_true_steady_curve(campaign, curves):
         assert abs(fit.evaluate(slip) - law["dp_n"]) < 0.02 * t["condition"]["load_n"]
 
 
+def test_the_fitting_route_of_docs_fitting_without_a_database(campaign, curves):
+    from fitting import fit_results, from_run_results
+    from run_results import results_table
+
+    results = results_table([r.result for r in campaign.runs])   # list of process_run results
+    fits = fit_results(from_run_results(results))
+    assert [f.coefficients for f in fits] == [f.coefficients for f in curves.fits]
+
+
 def test_export_and_read_wpm_round_trip_with_the_wheel(curves, tmp_path):
     path = tmp_path / "wpm.csv"
     path.write_text("an older export\n")
