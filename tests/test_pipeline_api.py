@@ -193,3 +193,18 @@ def test_report_renders_a_pipeline_campaign(tmp_path):
     (page,) = swtlab.report(small, tmp_path / "report.html").values()
     text = page.read_text()
     assert all(run_id in text for run_id in runs) and "data:image/png;base64," in text
+
+
+def test_swtlab_gap_refuses_another_wheel_unless_allowed(curves, tmp_path, capsys):
+    from swtlab_cli.main import main
+
+    swtlab.export_wpm(curves, tmp_path / "wpm.csv")
+    tm.save_model(tm.shipped_model("bb2_sand").with_wheel(radius_m=0.1), tmp_path / "sim.toml")
+    argv = ["gap", "--measured", str(tmp_path / "wpm.csv"), "--sim", str(tmp_path / "sim.toml")]
+    assert main(argv) == 3
+    assert "radius_m 0.125 vs 0.1 (tolerance 2 %)" in capsys.readouterr().err
+    assert main(argv + ["--allow-wheel-mismatch", "--boot", "5", "--effects", "bulldozing",
+                        "--json", str(tmp_path / "gap.json")]) == 0
+    assert "wheel mismatch allowed: radius_m 0.125 vs 0.1" in capsys.readouterr().out
+    report = json.loads((tmp_path / "gap.json").read_text())
+    assert report["wheel"]["simulated"]["radius_m"] == 0.1

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import tomllib
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
@@ -21,7 +21,7 @@ class ProcessSettings:
 
     channel_map: str | None = None
     rig: object = None
-    stable: object = field(default=None)
+    stable: object = None
     max_frames: int | None = None
 
     def __post_init__(self) -> None:
@@ -90,6 +90,7 @@ def process_file(path: Path, settings: ProcessSettings) -> ProcessedRun:
         done.run = ingest.read_run(path, channel_map=settings.channel_map)
         done.streams = report(done.run)["streams"]
     except ingest.IngestError as error:
+        done.run = None
         done.failures.append(Failure(str(path), "ingest", str(error)))
         return done
     except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
