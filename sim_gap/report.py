@@ -60,6 +60,17 @@ def _fmt(v) -> str:
     return "n/a" if v is None else f"{v:.4g}" if isinstance(v, float) else str(v)
 
 
+def _wheel_text(wheel: dict | None) -> str:
+    if not wheel:
+        return "n/a"
+    w = wheel["simulated"]
+    text = (f"r = {w['radius_m']:g} m, b = {w['width_m']:g} m, {w['grouser_count']} grousers "
+            f"of {w['grouser_height_m']:g} m")
+    if wheel["mismatches"]:
+        return text + " (simulated); MISMATCH allowed: " + "; ".join(wheel["mismatches"])
+    return text + " (measured and simulated agree)"
+
+
 def render_html(report: dict, heatmap_png: bytes | None) -> str:
     """One HTML page, no external resources."""
     verdict = report["verdict"]
@@ -85,7 +96,8 @@ def render_html(report: dict, heatmap_png: bytes | None) -> str:
 td,th{{border:1px solid #ccc;padding:2px 6px;font-size:90%}}</style></head><body>
 <h1>Sim-to-real gap</h1>
 <p>Measured: {html.escape(str(report['measured']))}<br>
-Simulated: {html.escape(str(report['simulated']))}</p>
+Simulated: {html.escape(str(report['simulated']))}<br>
+Wheel: {html.escape(_wheel_text(report.get('wheel')))}</p>
 <h2>Verdict: {html.escape(verdict_text)}</h2><p>{html.escape(report['reason'])}</p>
 {f"<p>Test that would decide: {html.escape(str(test.get('test')))} (leaders differ by "
  f"{test.get('separation_sigma')} sigma there)</p>" if test.get('test') else ""}

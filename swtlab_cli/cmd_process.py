@@ -72,18 +72,18 @@ def run(args: argparse.Namespace) -> int:
                 if known is not None:
                     flow_failed.append(f"{path}: {known.channel}: {known.problem}")
                 continue
-            done = process_file(path, settings)
-            stored = store_processed(session, done, parameters)
-        failed += [f.reason for f in done.failures if f.stage != "soil_flow"]
-        if done.result is None:
+            processed = process_file(path, settings)
+            stored = store_processed(session, processed, parameters)
+        failed += [f.reason for f in processed.failures if f.stage != "soil_flow"]
+        if processed.result is None:
             continue
         if not stored:
             up_to_date += 1
             continue
-        result = done.result
-        flows += done.flow is not None
-        flow_failed += [f"{done.run.source}: /camera/side: {f.reason}" for f in done.failures
-                        if f.stage == "soil_flow"]
+        result = processed.result
+        flows += processed.flow is not None
+        flow_failed += [f"{processed.run.source}: /camera/side: {f.reason}"
+                        for f in processed.failures if f.stage == "soil_flow"]
         reasons = "; ".join(result.flags)
         statuses.setdefault(result.status, []).append(
             f"{result.run_id}: {reasons}" if reasons else result.run_id)

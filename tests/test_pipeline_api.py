@@ -204,7 +204,9 @@ def test_swtlab_gap_refuses_another_wheel_unless_allowed(curves, tmp_path, capsy
     assert main(argv) == 3
     assert "radius_m 0.125 vs 0.1 (tolerance 2 %)" in capsys.readouterr().err
     assert main(argv + ["--allow-wheel-mismatch", "--boot", "5", "--effects", "bulldozing",
-                        "--json", str(tmp_path / "gap.json")]) == 0
+                        "--json", str(tmp_path / "gap.json"),
+                        "--html", str(tmp_path / "gap.html")]) == 0
     assert "wheel mismatch allowed: radius_m 0.125 vs 0.1" in capsys.readouterr().out
+    assert "MISMATCH allowed: radius_m 0.125 vs 0.1" in (tmp_path / "gap.html").read_text()
     report = json.loads((tmp_path / "gap.json").read_text())
     assert report["wheel"]["simulated"]["radius_m"] == 0.1
