@@ -7,18 +7,26 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 OUT ?= out
 
-.PHONY: demo test bench sample-data clean system-deps
+.PHONY: demo test bench sample-data clean system-deps lock
 
 # Debian's venv module is a separate package; install it only where it is missing.
 system-deps:
 	@$(PYTHON) -c "import ensurepip, venv" 2>/dev/null || \
 	  (apt-get update -qq && apt-get install -y -qq python3-venv)
 
-$(STAMP): pyproject.toml | system-deps
+# Exact versions (with hashes) from requirements.lock, then swtlab itself without resolving.
+$(STAMP): pyproject.toml requirements.lock | system-deps
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[test]'
+	$(BIN)/python -m pip install -q --require-hashes -r requirements.lock
+	$(BIN)/python -m pip install -q --no-deps -e .
 	touch $(STAMP)
+
+# Regenerate the lock file after a dependency change in pyproject.toml (newest versions that
+# satisfy it, for Python 3.11, every extra); commit the result.
+lock: | system-deps
+	$(PYTHON) -m pip install -q uv
+	$(PYTHON) -m uv pip compile pyproject.toml --extra test --extra bench --generate-hashes \
+	    --python-version 3.11 -o requirements.lock
 
 demo: $(STAMP)
 	mkdir -p $(OUT)
@@ -33,11 +41,11 @@ demo: $(STAMP)
 	@echo "         one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv,"
 	@echo "         sim-to-real gap report in $(OUT)/gap.html"
 
+# One worker per core (pytest-xdist); a test file stays on one worker, so module fixtures run once.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --dist loadfile
 
 bench: $(STAMP)
-	$(BIN)/python -m pip install -q -e '.[bench]'
 	$(BIN)/python -m bench
 
 sample-data: $(STAMP)

@@ -1,9 +1,12 @@
-"""Everything a campaign page shows, gathered from the database into plain objects.
+"""Everything a campaign page shows, as one plain object: :class:`CampaignData`.
 
-One :class:`CampaignData` per campaign: its runs (conditions, status, flags, stable window,
-where the raw file is, the stored DP trace of runs with no stable phase), the results table
-the fits read, the curves (those of the newest WPM export that holds the campaign's runs,
-else fitted here with :mod:`fitting`), and the load-interpolation checks.
+It comes from the database (:func:`gather`) or straight from in-memory pipeline results
+(:func:`from_results`); the page is drawn from it alone. One :class:`CampaignData` per
+campaign: its runs (conditions, status, flags, stable window, the decimated traces stored at
+processing, the DP trace of runs with no stable phase), the one-row-per-run results table,
+the curves (those of the newest WPM export that holds the campaign's runs, else fitted here
+with :mod:`fitting`), the load-interpolation checks, and the data of the optional sections
+(:mod:`campaign_report.extensions`). No raw file is read.
 """
 
 from __future__ import annotations
@@ -11,16 +14,22 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field
 from datetime import datetime
+from typing import Any
 
 import pandas as pd
 from sqlalchemy import select
+from sqlalchemy.engine import make_url
 from sqlalchemy.orm import Session
 
+from campaign_report.extensions import gather_extras
 from fitting import (CurveFit, FittingError, ValidationResult, fit_results, from_run_results,
                      validate_load_interpolation)
-from ingest import IngestError, read_run
-from traceability.models import Campaign, ProcessingRecord, RawFile, Run, RunResult, WpmExport
+from run_results import RunResult as ProcessedRun
+from run_results import results_table
+from run_results.traces import Trace
+from traceability.models import Campaign, RawFile, Run, RunResult, WpmExport
 from traceability.queries import latest_results
+from traceability.store_traces import traces_of, unpack_arrays
 
 #: statuses whose runs the curves are fitted from when no export says otherwise
 DEFAULT_STATUSES = ("ok",)
@@ -45,10 +54,24 @@ class RunRecord:
     flags: tuple[str, ...]
     window_start_s: float | None
     window_end_s: float | None
-    raw_path: str
-    channel_map: str | None
     dp_trace: dict | None
+    traces: dict[str, Trace] | None  # None: not stored (processed before migration 0006)
     means: dict[str, float] = field(default_factory=dict)
+
+    @classmethod
+    def from_result(cls, result: ProcessedRun) -> RunRecord:
+        """The record of an in-memory ``run_results.RunResult`` (``process_run``)."""
+        c, w = result.condition, result.window
+        return cls(run_id=result.run_id, wheel=c["wheel"], soil=c["soil"], mode=result.mode,
+                   multipass=int(c["multipass"]), load_n=float(c["load_n"]),
+                   slip_setpoint=_none_if_nan(c.get("slip_setpoint")),
+                   velocity_mps=float(c["velocity_mps"]), status=result.status,
+                   flags=tuple(result.flags),
+                   window_start_s=_none_if_nan(w.start_s) if w.found else None,
+                   window_end_s=_none_if_nan(w.end_s) if w.found else None,
+                   dp_trace=result.dp_trace, traces=dict(result.traces),
+                   means={k: float(q.mean) for k, q in result.quantities.items()
+                          if _none_if_nan(q.mean) is not None})
 
 
 @dataclass(frozen=True)
@@ -69,14 +92,22 @@ class CurveSource:
 
 @dataclass
 class CampaignData:
-    """A campaign's runs, results table, curves and interpolation checks."""
+    """A campaign's runs, results table, curves, interpolation checks and optional data.
+
+    ``results``: one row per run (docs/results.md columns); ``points``: the same in the
+    fitting columns (load_n, slip, dp_n, dp_n_se, ...); ``provenance``: (label, value) of
+    where the data comes from, printed in the page header; ``extras``: optional section name
+    -> its data (:mod:`campaign_report.extensions`)."""
 
     name: str
     runs: list[RunRecord]
-    points: pd.DataFrame  # fitting columns (load_n, slip, dp_n, dp_n_se, ...) + status, run_id
+    results: pd.DataFrame
+    points: pd.DataFrame
     fits: list[CurveFit]
     source: CurveSource
     validation: dict[SetKey, tuple[float, list[ValidationResult]]]
+    provenance: tuple[str, str]
+    extras: dict[str, Any] = field(default_factory=dict)
 
     @property
     def loads(self) -> list[float]:
@@ -111,12 +142,22 @@ def _none_if_nan(value) -> float | None:
     return None if value is None or pd.isna(value) else float(value)
 
 
+def _stored_traces(session: Session, ids: list[int]) -> dict[int, dict[str, Trace]]:
+    out = {}
+    for result_id, rows in traces_of(session, ids).items():
+        out[result_id] = {}
+        for row in rows:
+            t_s, values = unpack_arrays(row.arrays)
+            out[result_id][row.channel] = Trace(t_s=t_s, values=values, unit=row.unit,
+                                                samples=row.samples, block=row.block)
+    return out
+
+
 def _run_records(session: Session, results: pd.DataFrame) -> list[RunRecord]:
     ids = [int(i) for i in results["result_id"]]
     extra = {row.id: row for row in session.execute(
-        select(RunResult.id, RunResult.dp_trace, RunResult.flags, ProcessingRecord.parameters)
-        .join(ProcessingRecord, ProcessingRecord.id == RunResult.processing_id)
-        .where(RunResult.id.in_(ids)))}
+        select(RunResult.id, RunResult.dp_trace, RunResult.flags).where(RunResult.id.in_(ids)))}
+    traces = _stored_traces(session, ids)
     means = [c for c in results.columns if c.endswith("_mean")]
     runs = []
     for row in results.to_dict("records"):
@@ -127,8 +168,8 @@ def _run_records(session: Session, results: pd.DataFrame) -> list[RunRecord]:
             slip_setpoint=_none_if_nan(row["slip_setpoint"]),
             velocity_mps=float(row["velocity_set_mps"]), status=row["status"],
             flags=tuple(more.flags), window_start_s=_none_if_nan(row["window_start_s"]),
-            window_end_s=_none_if_nan(row["window_end_s"]), raw_path=row["raw_file_path"],
-            channel_map=(more.parameters or {}).get("channel_map"), dp_trace=more.dp_trace,
+            window_end_s=_none_if_nan(row["window_end_s"]), dp_trace=more.dp_trace,
+            traces=traces.get(int(row["result_id"])),
             means={c.removesuffix("_mean"): v for c in means
                    if (v := _none_if_nan(row[c])) is not None}))
     return runs
@@ -172,6 +213,11 @@ def _curves(session: Session, campaign_id: int, results: pd.DataFrame
         found = _from_export(row, latest_ids, campaign_ids)
         if found:
             return found
+    return _fitted_here(results)
+
+
+def _fitted_here(results: pd.DataFrame) -> tuple[list[CurveFit], CurveSource]:
+    """Curves fitted as ``swtlab export`` would, when no export holds the campaign's runs."""
     table = from_run_results(results, statuses=DEFAULT_STATUSES)
     fits = fit_results(table, degree=DEFAULT_DEGREE, too_few=[]) if len(table) else []
     return fits, CurveSource(None, None, None, DEFAULT_DEGREE, DEFAULT_STATUSES, stale=False)
@@ -207,26 +253,45 @@ def _validation(points: pd.DataFrame, fits: list[CurveFit], source: CurveSource
     return out
 
 
-def gather(session: Session, name: str) -> CampaignData:
-    """Everything the page of campaign ``name`` shows. Raises ``LookupError`` when the
-    database has no processed run of that campaign."""
+def campaign_data(name: str, results: pd.DataFrame, runs: list[RunRecord],
+                  curves: tuple[list[CurveFit], CurveSource] | None = None,
+                  provenance: tuple[str, str] = ("source", "in-memory results"),
+                  extras: dict[str, Any] | None = None) -> CampaignData:
+    """A page's data from a one-row-per-run ``results`` table and the runs' records;
+    ``curves`` (fits and where they come from) default to fits made here."""
+    if results.empty:
+        raise LookupError(f"no processed runs of campaign {name!r}")
+    results = results.reset_index(drop=True)
+    fits, source = curves if curves is not None else _fitted_here(results)
+    points = from_run_results(results, statuses=("ok", "flagged"))
+    return CampaignData(name=name, runs=runs, results=results, points=points, fits=fits,
+                        source=source, validation=_validation(points, fits, source),
+                        provenance=provenance, extras=dict(extras or {}))
+
+
+def from_results(name: str, results: list[ProcessedRun],
+                 provenance: tuple[str, str] = ("source", "in-memory pipeline results"),
+                 extras: dict[str, Any] | None = None) -> CampaignData:
+    """A page's data straight from ``process_run`` results, without a database (curves
+    fitted here; ``extras``: optional sections' data, e.g. none)."""
+    return campaign_data(name, results_table(results),
+                         [RunRecord.from_result(r) for r in results], provenance=provenance,
+                         extras=extras)
+
+
+def gather(session: Session, name: str, db_url: str | None = None) -> CampaignData:
+    """Everything the page of campaign ``name`` shows, from the database (``db_url`` is
+    printed, password hidden). Raises ``LookupError`` when the database has no processed
+    run of that campaign."""
     campaign = session.scalars(select(Campaign).filter_by(name=name)).first()
     results = latest_results(session)
     results = results[results["campaign"] == name] if len(results) else results
     if campaign is None or results.empty:
         raise LookupError(f"no processed runs of campaign {name!r}")
     results = results.reset_index(drop=True)
-    fits, source = _curves(session, campaign.id, results)
-    points = from_run_results(results, statuses=("ok", "flagged"))
-    return CampaignData(name=name, runs=_run_records(session, results), points=points,
-                        fits=fits, source=source,
-                        validation=_validation(points, fits, source))
-
-
-def read_channels(run: RunRecord) -> tuple[pd.DataFrame | None, str | None]:
-    """The run's channel table read again from its recorded raw file (with the channel map it
-    was processed with), or None and the one-line reason when that file cannot be read."""
-    try:
-        return read_run(run.raw_path, run.channel_map).channels, None
-    except (IngestError, OSError, ValueError) as error:
-        return None, f"raw file {run.raw_path} not readable: {error}"
+    where = make_url(db_url).render_as_string(hide_password=True) if db_url else "?"
+    data = campaign_data(name, results, _run_records(session, results),
+                         curves=_curves(session, campaign.id, results),
+                         provenance=("database", where))
+    data.extras = gather_extras(session, data)
+    return data

@@ -15,11 +15,11 @@ from matplotlib.lines import Line2D
 from campaign_report.data import RunRecord, SetKey
 from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from fitting import CurveFit, ValidationResult, curves_by_load, interpolate_load
+from run_results.traces import TRACE_QUANTITIES
 from wpm_export import WheelPerformanceModule
 
-#: channels of the per-run time series: (channel column, quantity shown)
-TIMESERIES = (("dp_n", "dp_n"), ("ty_nm", "torque_nm"), ("sinkage_m", "sinkage_m"),
-              ("slip", "slip"))
+#: what an axis says for a run processed before traces were stored
+NOT_STORED = "trace not stored; re-run swtlab process"
 WINDOW_COLOUR = "#cfe3cf"
 CURVE_POINTS = 200
 
@@ -35,19 +35,22 @@ def _robust_limits(ax, values: np.ndarray) -> None:
 
 
 def _no_data(ax, text: str) -> None:
-    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4")
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4",
+            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85})
 
 
-def run_timeseries(run: RunRecord, channels: pd.DataFrame | None, palette: Palette) -> Figure:
-    """Drawbar pull, torque, sinkage and slip against time, the stable window shaded with
-    each quantity's mean over it; a run with no stable phase gets its stored DP trace and the
-    reason. ``channels``: ``ingest.read_run(...).channels`` or None if the raw file is gone."""
+def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
+    """Drawbar pull, torque, sinkage and slip against time from the traces stored at
+    processing (min/max per block, ``run_results.traces``), the stable window shaded with
+    each quantity's mean over it; a run with no stable phase gets the reason in its title.
+    A run processed before traces were stored says so (and shows its stored DP trace, if it
+    has no stable phase)."""
     fig = Figure(figsize=(8.0, 6.4))  # fixed margins: constrained layout would double the cost
-    axes = fig.subplots(len(TIMESERIES), 1, sharex=True)
+    axes = fig.subplots(len(TRACE_QUANTITIES), 1, sharex=True)
     top = 0.93 if run.status != "no_stable_phase" else 0.86
     fig.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
     colour = palette.colour(run.load_n)
-    for ax, (column, key) in zip(axes, TIMESERIES):
+    for ax, key in zip(axes, TRACE_QUANTITIES):
         q = QUANTITIES[key]
         ax.set_ylabel(q.axis_label)
         ax.grid(alpha=0.3)
@@ -57,15 +60,16 @@ def run_timeseries(run: RunRecord, channels: pd.DataFrame | None, palette: Palet
             if key in run.means:
                 ax.hlines(run.means[key] * q.scale, run.window_start_s, run.window_end_s,
                           colors="k", linestyles="--", lw=1.2, label="mean over window")
-        values = None if channels is None else channels[column].to_numpy(float) * q.scale
-        if values is not None and np.isfinite(values).any():
-            ax.plot(channels["t_s"], values, color=colour, lw=0.8, label="raw file")
+        trace = None if run.traces is None else run.traces.get(key)
+        if trace is not None:
+            values = np.asarray(trace.values, float) * q.scale
+            ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
             _robust_limits(ax, values)
-        elif not (key == "dp_n" and run.dp_trace):
-            _no_data(ax, "not measured" if channels is not None else "raw file not readable")
-        if key == "dp_n" and run.dp_trace:
-            trace = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
-            ax.plot(run.dp_trace["t_s"], trace, color="k", lw=1.0, label="stored DP trace")
+            continue
+        _no_data(ax, NOT_STORED if run.traces is None else "not measured")
+        if key == "dp_n" and run.traces is None and run.dp_trace:  # older results: this only
+            dp = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
+            ax.plot(run.dp_trace["t_s"], dp, color="k", lw=1.0, label="stored DP trace")
     axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
     labelled = {}
     for ax in axes:

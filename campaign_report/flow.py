@@ -6,9 +6,13 @@ docs/softflow.md) or frames that could not be analysed. Per run: the speed map o
 frame, the profiles with their decay fits, ``k(beta)`` and ``alpha3(beta)`` with their CIs,
 and the grouser-model scores; the figures are :mod:`softflow.flow_plots`' own, drawn from the
 stored result and its compact arrays (``softflow.flow_archive``), not from the raw frames.
+Its data (``data.extras["soil-flow"]``): :class:`FlowData`, read from the database by
+:func:`gather_flows` or built by a pipeline from its own flow results.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, fields
 
 import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
@@ -23,15 +27,44 @@ from campaign_report.style import Palette
 from softflow import flow_plots
 from softflow.flow_archive import unpack_flow
 from traceability.models import RawFile, Run, RunResult, SoilFlow, SoilFlowFailure
-from traceability.queries import latest_results
+
+
+NAME = "soil-flow"
+
+
+@dataclass(frozen=True)
+class FlowRecord:
+    """One run's soil flow as the section shows it (the ``soil_flow`` columns it reads):
+    ``result`` is ``FlowResult.to_dict()``, ``field_npz`` ``softflow.flow_archive.pack_flow``."""
+
+    frame_first: int
+    frame_last: int
+    t_first_s: float
+    t_last_s: float
+    pairs: int
+    engine: str
+    sled_velocity_x_mps: float
+    outlier_fraction: float
+    grouser_model: str | None
+    grouser_margin_percent: float | None
+    alpha1_per_m: float | None
+    alpha2: float | None
+    result: dict
+    field_npz: bytes
+
+
+@dataclass(frozen=True)
+class FlowData:
+    """(run_id, flow) of every run with a soil flow; (run_id, channel, problem) of every run
+    whose frames could not be analysed."""
+
+    flows: list[tuple[str, FlowRecord]]
+    failures: list[tuple[str, str, str]]
 
 
 def _newest(session: Session, data: CampaignData, model) -> list:
     """(run_id, row) of ``model`` stored with the newest result of each of the campaign's runs."""
-    table = latest_results(session)
-    if table.empty:
-        return []
-    ids = [int(i) for i in table.loc[table["campaign"] == data.name, "result_id"]]
+    ids = [int(i) for i in data.results["result_id"]]
     return session.execute(
         select(Run.run_id, model)
         .join(RunResult, (RunResult.raw_file_id == model.raw_file_id)
@@ -63,7 +96,17 @@ def _image(anchor: str, caption: str, fig) -> Image:
     return Image(anchor, caption, png, thumbnail(full))
 
 
-def _figures(index: int, run_id: str, row: SoilFlow) -> list[Image]:
+def gather_flows(session: Session, data: CampaignData) -> FlowData | None:
+    """The stored soil flows and flow failures of the campaign's newest results; None: none."""
+    names = [f.name for f in fields(FlowRecord)]
+    flows = [(run_id, FlowRecord(**{n: getattr(row, n) for n in names}))
+             for run_id, row in _newest(session, data, SoilFlow)]
+    failures = [(run_id, f.channel, f.problem)
+                for run_id, f in _newest(session, data, SoilFlowFailure)]
+    return FlowData(flows, failures) if flows or failures else None
+
+
+def _figures(index: int, run_id: str, row: FlowRecord) -> list[Image]:
     result, frame = unpack_flow(row.result, row.field_npz)
     anchor = f"flow-{index}"
     images = [
@@ -93,19 +136,19 @@ def _summary(flows: list) -> Table:
                  numeric=frozenset({3, 5, 6}))
 
 
-def flow_section(session: Session, data: CampaignData, palette: Palette) -> Section | None:
+def flow_section(data: CampaignData, palette: Palette) -> Section | None:
     """Soil flow of every run of the campaign with side-camera frames; None without any."""
-    flows = _newest(session, data, SoilFlow)
-    failures = _newest(session, data, SoilFlowFailure)
-    if not flows and not failures:
+    found: FlowData | None = data.extras.get(NAME)
+    if found is None:
         return None
+    flows, failures = found.flows, found.failures
     blocks: list = [Note("Soil velocity under the wheel from the side-camera frames of each "
                          "run's stable window (SOFT): speed over the frame, radial and "
                          "tangential profiles with their exponential fits, the decay rates "
                          "k(beta) and alpha3(beta) with 95 % confidence intervals, and the "
                          "grouser effective-radius models scored against the field.")]
-    blocks += [Note(f"{run_id}: soil flow not measured: {f.channel}: {f.problem}", warning=True)
-               for run_id, f in failures]
+    blocks += [Note(f"{run_id}: soil flow not measured: {channel}: {problem}", warning=True)
+               for run_id, channel, problem in failures]
     if flows:
         blocks.append(_summary(flows))
     for i, (run_id, row) in enumerate(flows):
@@ -114,4 +157,4 @@ def flow_section(session: Session, data: CampaignData, palette: Palette) -> Sect
     return Section("soil-flow", "Soil flow under the wheel", blocks)
 
 
-register(Extension("soil-flow", flow_section))
+register(Extension(NAME, flow_section, gather_flows))

@@ -2,7 +2,8 @@
 
 Registered as an optional section (:mod:`campaign_report.extensions`): it appears when
 ``swtlab gap --measured <this database>`` has recorded a report (docs/gap-report.md): the
-verdict and its reason, the residual heatmap, and the ranked explanations.
+verdict and its reason, the residual heatmap, and the ranked explanations. Its data
+(``data.extras["gap"]``): ``{"sim_source": ..., "report": ...}`` as ``gap_report`` stores them.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from sim_gap.regions import heatmap_png
 from traceability.models import GapReport
 
 CANDIDATES_SHOWN = 8
+NAME = "gap"
 
 
 def _verdict(report: dict) -> str:
@@ -27,13 +29,19 @@ def _verdict(report: dict) -> str:
     return ", ".join(verdict) if verdict else "no missing effect"
 
 
-def gap_section(session: Session, data: CampaignData, palette: Palette) -> Section | None:
-    """Verdict, heatmap and ranked candidates of the newest gap report; None without one."""
+def gather_gap(session: Session, data: CampaignData) -> dict | None:
+    """The newest gap report recorded in the database; None without one."""
     row = session.scalars(select(GapReport).order_by(GapReport.id.desc())).first()
-    if row is None:
+    return None if row is None else {"sim_source": row.sim_source, "report": row.report}
+
+
+def gap_section(data: CampaignData, palette: Palette) -> Section | None:
+    """Verdict, heatmap and ranked candidates of the newest gap report; None without one."""
+    found = data.extras.get(NAME)
+    if found is None:
         return None
-    report = row.report
-    blocks: list = [Note(f"Simulation {row.sim_source} against the measurements of this "
+    report = found["report"]
+    blocks: list = [Note(f"Simulation {found['sim_source']} against the measurements of this "
                          f"database: verdict \"{_verdict(report)}\". {report['reason']}",
                          warning=report["verdict"] == "inconclusive")]
     if report.get("separating_test"):
@@ -53,4 +61,4 @@ def gap_section(session: Session, data: CampaignData, palette: Palette) -> Secti
     return Section("gap", "Sim-to-real gap", blocks)
 
 
-register(Extension("gap", gap_section))
+register(Extension(NAME, gap_section, gather_gap))

@@ -1,21 +1,20 @@
 """Report section: slip read from track photos against encoder slip (RUAG SWT: below 1 %).
 
 Registered as an optional section (:mod:`campaign_report.extensions`): it appears only
-when runs of the campaign carry an ``image_slip`` result (track photos, docs/track-slip.md).
+when runs of the campaign carry an ``image_slip`` result (track photos, docs/track-slip.md),
+read from the campaign's results table.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
-from sqlalchemy.orm import Session
 
 from campaign_report.data import CampaignData
 from campaign_report.extensions import Extension, register
 from campaign_report.html import Image, Note, Section, Table
 from campaign_report.images import to_png
 from campaign_report.style import Palette
-from traceability.queries import latest_results
 
 #: the agreement the RUAG campaign reports between photo and facility slip
 AGREEMENT = 0.01
@@ -41,13 +40,12 @@ def _figure(rows, palette: Palette) -> Figure:
     return fig
 
 
-def image_slip_section(session: Session, data: CampaignData, palette: Palette) -> Section | None:
+def image_slip_section(data: CampaignData, palette: Palette) -> Section | None:
     """Image slip beside encoder slip for every run with track photos; None without any."""
-    table = latest_results(session)
-    if table.empty or "image_slip_mean" not in table:
+    table = data.results
+    if "image_slip_mean" not in table or "slip_mean" not in table:
         return None
-    rows = table[(table["campaign"] == data.name) & table["image_slip_mean"].notna()
-                 & table["slip_mean"].notna()]
+    rows = table[table["image_slip_mean"].notna() & table["slip_mean"].notna()]
     if rows.empty:
         return None
     difference = rows["image_slip_mean"] - rows["slip_mean"]

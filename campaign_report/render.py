@@ -1,22 +1,29 @@
-"""Write a campaign's report page: gather, draw, assemble, write."""
+"""Write a campaign's report page: data in (:class:`~campaign_report.data.CampaignData`, from
+the database or from in-memory results), figures drawn, page assembled, file written."""
 
 from __future__ import annotations
 
+import os
 import re
+import tempfile
+from collections.abc import Callable, Iterable
 from datetime import UTC, datetime
-from importlib.metadata import version
 from pathlib import Path
-
-from sqlalchemy.engine import make_url
-from sqlalchemy.orm import Session
 
 from campaign_report import sections
 from campaign_report.data import CampaignData, campaign_names, gather
 from campaign_report.extensions import optional_sections
 from campaign_report.html import Page, render_page
 from campaign_report.style import Palette
-from swtlab_cli.progress import progress
 from traceability import open_database
+from traceability.provenance import swtlab_version
+
+#: ``progress(items, desc)`` -> the same items, e.g. shown as a bar by the caller (the CLI)
+Progress = Callable[[list, str], Iterable]
+
+
+def _no_progress(items: list, desc: str) -> Iterable:
+    return items
 
 
 def page_paths(path: str | Path, names: list[str]) -> dict[str, Path]:
@@ -35,32 +42,47 @@ def page_paths(path: str | Path, names: list[str]) -> dict[str, Path]:
     return out
 
 
-def build_page(session: Session, data: CampaignData, db_url: str, quiet: bool = False) -> Page:
-    """Every section of one campaign's page (figures drawn here; a bar over the runs)."""
+def build_page(data: CampaignData, progress: Progress = _no_progress) -> Page:
+    """Every section of one campaign's page, drawn from ``data`` alone."""
     palette = Palette(data.loads, data.multipasses)
-    images = []
-    for i, run in progress(list(enumerate(data.runs)), desc=f"report {data.name}",
-                           quiet=quiet):
-        images.append(sections.timeseries_image(i, run, palette))
+    images = [sections.timeseries_image(i, run, palette)
+              for i, run in progress(list(enumerate(data.runs)), f"report {data.name}")]
     parts = [sections.runs_section(data), sections.timeseries_section(images)]
     if data.fits:
         parts.append(sections.curves_section(data, palette))
     parts += [s for s in (sections.interpolation_section(data, palette),
                           sections.wpm_section(data, palette)) if s is not None]
-    parts += optional_sections(session, data, palette)
-    meta = [("database", make_url(db_url).render_as_string(hide_password=True)),
+    parts += optional_sections(data, palette)
+    meta = [data.provenance,
             ("wheel / soil", ", ".join(sorted({f"{r.wheel} / {r.soil}" for r in data.runs}))),
             ("loads", ", ".join(f"{x:g} N" for x in data.loads)),
             ("multipass", ", ".join(str(m) for m in data.multipasses)),
             ("generated", datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
-             + f" by swtlab {version('swtlab')}")]
+             + f" by swtlab {swtlab_version()}")]
     return Page(f"SWT campaign {data.name}", meta, parts,
                 footer="Self-contained page written by swtlab report: every figure is "
                        "embedded, nothing is fetched from the network.")
 
 
-def write_report(db_url: str, path: str | Path, quiet: bool = False,
-                 campaign: str | None = None) -> Path:
+def render_report(data: CampaignData, path: str | Path,
+                  progress: Progress = _no_progress) -> Path:
+    """Write the page of ``data`` to ``path`` (atomically: a reader never sees half a page)."""
+    text = render_page(build_page(data, progress))
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def write_report(db_url: str, path: str | Path, campaign: str | None = None,
+                 progress: Progress = _no_progress) -> Path:
     """Write the page of ``campaign`` (default: the database's only campaign) to ``path``.
 
     Raises ``LookupError`` (one line, what to do) when the database has no processed run,
@@ -75,18 +97,16 @@ def write_report(db_url: str, path: str | Path, quiet: bool = False,
         name = campaign or names[0]
         if name not in names:
             raise LookupError(f"no campaign {name!r} in {db_url}; it has {', '.join(names)}")
-        page = build_page(session, gather(session, name), db_url, quiet)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(render_page(page), encoding="utf-8")
-    return path
+        data = gather(session, name, db_url)
+    return render_report(data, path, progress)
 
 
-def write_reports(db_url: str, path: str | Path, quiet: bool = False) -> dict[str, Path]:
+def write_reports(db_url: str, path: str | Path,
+                  progress: Progress = _no_progress) -> dict[str, Path]:
     """One page per campaign of the database, named by :func:`page_paths`: campaign -> page."""
     with open_database(db_url)() as session:
         names = campaign_names(session)
     if not names:
         raise LookupError(f"{db_url}: no processed runs (run swtlab process first)")
-    return {name: write_report(db_url, p, quiet, name)
+    return {name: write_report(db_url, p, name, progress)
             for name, p in page_paths(path, names).items()}

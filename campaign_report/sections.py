@@ -6,10 +6,11 @@ from collections.abc import Iterable
 from html import escape
 
 from campaign_report import figures
-from campaign_report.data import CampaignData, RunRecord, read_channels
+from campaign_report.data import CampaignData, RunRecord
 from campaign_report.html import Heading, Image, Note, Section, Table
 from campaign_report.images import thumbnail, to_png
 from campaign_report.style import QUANTITIES, Palette
+from run_results.traces import MAX_TRACE_POINTS
 from wpm_export import WheelPerformanceModule
 
 RUNS = "runs"
@@ -62,19 +63,22 @@ def runs_section(data: CampaignData) -> Section:
 
 
 def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Image:
-    """A run's time-series thumbnail/full-size pair; the caption says why when its raw file
-    could not be read."""
-    channels, problem = read_channels(run)
-    png, image = to_png(figures.run_timeseries(run, channels, palette))
-    caption = f"{run.run_id} · {run.status}" + (f" · {problem}" if problem else "")
+    """A run's time-series thumbnail/full-size pair; the caption says so when the run was
+    processed before its traces were stored."""
+    png, image = to_png(figures.run_timeseries(run, palette))
+    caption = (f"{run.run_id} · {run.status}"
+               + (f" · {figures.NOT_STORED}" if run.traces is None else ""))
     return Image(run_anchor(index), caption, png, thumbnail(image), run.status)
 
 
 def timeseries_section(images: Iterable[Image]) -> Section:
     return Section(TIMESERIES, "Time series per run", [Note(
-        "Drawbar pull, torque, sinkage and slip from each run's raw file; the stable window "
-        "shaded, the dashed line its mean. Runs with no stable phase show the DP trace "
-        "stored by processing and the reason. Click a thumbnail for full size."), *images])
+        "Drawbar pull, torque, sinkage and slip as stored by processing (each channel's "
+        f"minimum and maximum per block of samples, at most {MAX_TRACE_POINTS} points: the "
+        "envelope of the full signal); the stable window shaded, the dashed line its mean. "
+        "Runs with no stable phase give the reason in the title. Click a thumbnail for full "
+        "size."),
+        *images])
 
 
 def _source_notes(data: CampaignData) -> list[Note]:

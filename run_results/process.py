@@ -8,7 +8,9 @@ steered runs also the side force ``fy`` and the slip angle (logged channel, else
 set steering angle). Single-channel quantities come from the native samples, the means of
 resistance and sinkage from the channels' native means (``native``). Runs with track photos
 (``/camera/track``) also get ``image_slip``, the slip read from the grouser marks
-(``softflow.track_run``), beside the encoder slip.
+(``softflow.track_run``), beside the encoder slip. Every result carries its channels'
+decimated traces of DP, torque, sinkage and slip (``run_results.traces``), so plots need not
+read the raw file again.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from run_results.native import native_quantities
 from run_results.phase_average import phase_average
 from run_results.result import RunResult
 from run_results.stats import QuantityStats, quantity_stats
+from run_results.traces import run_traces
 from softflow.track_run import run_image_slip
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
@@ -98,8 +101,8 @@ def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
             out[f"{name}_peak_to_peak_{unit}"] = float(np.nanmax(wave) - np.nanmin(wave))
         else:
             out[f"{name}_peak_{unit}"] = out[f"{name}_peak_to_peak_{unit}"] = None
-    out["method"] = ("Hann zero-padded FFT peak within +-40 % of n*omega/2pi, refined by "
-                     f"least squares on a {osc.HARMONICS}-harmonic series; peaks from the "
+    out["method"] = (f"least squares on a {osc.HARMONICS}-harmonic series, global minimum on a "
+                     "grid over +-40 % of n*omega/2pi refined by Brent; peaks from the "
                      "phase-averaged waveform")
     return out, frequency
 
@@ -145,7 +148,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     corrections = {"tare": tare_record(run),
                    "rig_compliance": None if rig is None else rig.to_dict()}
     common = {"run_id": run.run_id, "mode": run.metadata.run.mode, "window": window,
-              "condition": _condition(run)}
+              "condition": _condition(run), "traces": run_traces(t, series)}
     if not window.found:
         tb, dpb = decimate_mean(t, run.channels["dp_n"].to_numpy(), DP_TRACE_POINTS)
         trace = {"t_s": tb.tolist(), "dp_n": [None if not np.isfinite(v) else float(v)

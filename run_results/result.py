@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from run_results.stats import QuantityStats
+from run_results.traces import Trace
 from stable_phase import StableWindow
 from plain_json import jsonable
 from swtlab.domain.results import STATUSES
@@ -13,7 +14,9 @@ from swtlab.domain.results import STATUSES
 @dataclass(frozen=True)
 class RunResult:
     """Per-run results (see docs/run-results.md). ``condition``: wheel, soil, multipass,
-    set load, set slip, steering angle and velocity, for grouping runs across a campaign."""
+    set load, set slip, steering angle and velocity, for grouping runs across a campaign.
+    ``traces``: channel -> decimated :class:`run_results.traces.Trace` for plots (arrays,
+    left out of :meth:`to_dict`)."""
 
     run_id: str
     mode: str
@@ -25,6 +28,7 @@ class RunResult:
     dp_trace: dict | None
     corrections: dict
     condition: dict = field(default_factory=dict)
+    traces: dict[str, Trace] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:

@@ -1,10 +1,11 @@
 """Candidate explanations of the gap: soil-only recalibration, each missing effect, pairs.
 
 Each candidate frees a few well-posed parameters: three soil parameters (Bekker k_phi,
-friction angle, Janosi-Hanamoto K; Bekker 1969, Janosi & Hanamoto 1961) plus one strength
-per effect (two for wheel flexibility: stiffness and hysteresis), with the bounds below.
-The effects and their parameters are those of ``terramechanics.effects`` (see their
-docstrings and docs/model-file.md).
+friction angle, Janosi-Hanamoto K; Bekker 1969, Janosi & Hanamoto 1961) plus the strengths
+that each effect's law declares with their bounds (``fit`` of the law class, e.g. two for
+the default wheel flexibility: stiffness and hysteresis). A candidate uses the law the
+simulation model has for an effect, else the effect's default law (see
+``terramechanics.effects`` and docs/model-file.md).
 """
 
 from __future__ import annotations
@@ -37,18 +38,6 @@ class Candidate:
         return "+".join(self.effects) if self.effects else "soil_only"
 
 
-#: strength parameters of each effect: (dotted suffix, start, lower, upper, log)
-EFFECT_PARAMS: dict[str, tuple[tuple[str, float, float, float, bool], ...]] = {
-    "grousers": (("shear_radius_factor", 0.5, 0.0, 1.5, False),),
-    "slip_sinkage": (("n1", 0.3, 0.0, 1.5, False),),
-    "reduced_gravity": (("bearing_exponent", 1.0, 0.0, 2.5, False),),
-    "wheel_flexibility": (("radial_stiffness_n_m", 3e4, 5e3, 5e5, True),
-                          ("hysteresis_coefficient", 0.02, 0.0, 0.1, False)),
-    "multipass": (("stiffness_gain_per_pass", 0.2, 0.0, 1.5, False),),
-    "bulldozing": (("coefficient", 0.5, 0.0, 5.0, False),),
-}
-
-
 def soil_params(model: tm.WheelModel) -> tuple[Param, ...]:
     """k_phi and K within a factor 5 of the simulation's, friction angle within 10 deg."""
     s = model.soil
@@ -60,14 +49,17 @@ def soil_params(model: tm.WheelModel) -> tuple[Param, ...]:
                   s.shear_modulus_m * 5, True))
 
 
-def effect_params(name: str) -> tuple[Param, ...]:
-    return tuple(Param(f"effects.{name}.{p}", *rest) for p, *rest in EFFECT_PARAMS[name])
+def effect_params(name: str, law: str | None = None) -> tuple[Param, ...]:
+    """The strength parameters the law (default: the effect's default law) declares."""
+    return tuple(Param(f"effects.{name}.{p.name}", p.start, p.lower, p.upper, p.log)
+                 for p in tm.law_class(name, law).fit)
 
 
 def candidate(model: tm.WheelModel, effects: tuple[str, ...]) -> Candidate:
     """Soil parameters and the strengths of ``effects`` (kept in the vocabulary's order)."""
     effects = tuple(sorted(effects, key=list(tm.EFFECTS).index))
-    params = soil_params(model) + tuple(p for e in effects for p in effect_params(e))
+    laws = {e: model.effects[e].law if e in model.effects else None for e in effects}
+    params = soil_params(model) + tuple(p for e in effects for p in effect_params(e, laws[e]))
     return Candidate(tuple(effects), params)
 
 

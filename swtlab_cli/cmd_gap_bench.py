@@ -1,4 +1,4 @@
-"""``swtlab gap-bench --n N --seed S``: the blind check of the gap diagnosis (sim_gap.bench)."""
+"""``swtlab gap-bench --n N --seed S``: the blind gap-diagnosis check (validation.gap_bench)."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim_gap.bench import FAST_DESIGN, Design, format_score, run_bench
+    from validation.gap_bench import FAST_DESIGN, Design, format_score, run_bench
 
     if args.n < 1:
         print("swtlab gap-bench: --n must be >= 1")

@@ -2,9 +2,10 @@
 
 Each run is one transaction: a batch killed midway loses nothing stored, and the
 next call finishes it without duplicates (a file already processed with the same
-parameters is skipped without being read). A run with side-camera frames also gets its
-soil flow over the stable window (``softflow.flow_run``); frames that cannot be analysed
-are reported and recorded, and the run's other results are kept.
+parameters is skipped without being read). Each result is stored with its decimated
+traces (``run_results.traces``), which the report draws. A run with side-camera frames
+also gets its soil flow over the stable window (``softflow.flow_run``); frames that cannot
+be analysed are reported and recorded, and the run's other results are kept.
 """
 
 from __future__ import annotations

@@ -43,6 +43,10 @@ def run(args: argparse.Namespace) -> int:
     from sqlalchemy.exc import SQLAlchemyError
 
     from campaign_report import write_report, write_reports
+    from swtlab_cli.progress import progress
+
+    def bar(items: list, desc: str):
+        return progress(items, desc=desc, quiet=args.quiet)
 
     missing = _missing_sqlite_file(args.db)
     if missing:
@@ -51,10 +55,9 @@ def run(args: argparse.Namespace) -> int:
         return exit_codes.BAD_INPUT
     try:
         if args.campaign:
-            pages = {args.campaign: write_report(args.db, args.output, args.quiet,
-                                                 args.campaign)}
+            pages = {args.campaign: write_report(args.db, args.output, args.campaign, bar)}
         else:
-            pages = write_reports(args.db, args.output, args.quiet)
+            pages = write_reports(args.db, args.output, bar)
     except LookupError as error:
         print(f"swtlab report: {error.args[0]}", file=sys.stderr)
         return exit_codes.BAD_INPUT

@@ -16,23 +16,16 @@ SUBCOMMANDS = ["inspect", "process", "results", "export", "wpm", "report", "sim"
                "track_slip", "flow", "gap", "gap_bench"]
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("swtlab")
-    except PackageNotFoundError:
-        return "unknown"
-
-
 def build_parser() -> argparse.ArgumentParser:
+    from traceability.provenance import swtlab_version
+
     parser = argparse.ArgumentParser(
         prog="swtlab",
         description="Single-wheel testbed data: raw runs to wheel characterisation.",
         epilog=exit_codes.EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--version", action="version", version=f"swtlab {_version()}")
+    parser.add_argument("--version", action="version", version=f"swtlab {swtlab_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in SUBCOMMANDS:
         importlib.import_module(f"swtlab_cli.cmd_{name}").register(sub)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from terramechanics import stress
-from terramechanics.effects import EFFECTS, Effect, make_effect
+from terramechanics.effects import EFFECTS, LAWS, Effect, make_effect
 from terramechanics.equilibrium import solve_increasing
 from terramechanics.soil import SoilParams
 from terramechanics.state import (EARTH_GRAVITY_MPS2, Condition, Contact, Geometry,
@@ -48,7 +48,9 @@ class WheelModel:
     # -- switching effects and parameters -------------------------------------------------
     def with_effects(self, **changes: bool | dict | Effect | None) -> WheelModel:
         """Switch effects: ``True`` on (current or default parameters), ``False``/``None``
-        off, a dict of parameters (merged into the current ones) or an ``Effect``."""
+        off, a dict of parameters (merged into the current ones; a ``"law"`` key picks
+        another law of the effect, with its defaults for what the dict does not name)
+        or an ``Effect``."""
         effects = dict(self.effects)
         for name, change in changes.items():
             if change is None or change is False:
@@ -57,9 +59,12 @@ class WheelModel:
                 effects[name] = effects.get(name) or make_effect(name)
             elif isinstance(change, Effect):
                 effects[name] = change
+            elif "law" in change and change["law"] != getattr(effects.get(name), "law", None):
+                effects[name] = make_effect(name, **change)
             else:
-                current = effects.get(name) or make_effect(name)
-                effects[name] = replace(current, **change)
+                current = effects.get(name) or make_effect(name, change.get("law"))
+                effects[name] = replace(current, **{k: v for k, v in change.items()
+                                                    if k != "law"})
         return replace(self, effects=effects)
 
     def with_soil(self, **changes: float) -> WheelModel:
@@ -117,11 +122,14 @@ class WheelModel:
                                        for x in (load_n, slip, multipass, g)))
         if np.any(arrays[0] <= 0):
             raise ValueError("load_n must be > 0")
+        if np.any(arrays[1] < -1):
+            raise ValueError("slip must be >= -1 (a locked wheel)")
         cond = Condition(*(a.copy() for a in arrays))
         soil, geo = self._soil_state(cond), self._base_geometry(cond)
         for effect in self.effects.values():
             soil = effect.soil(soil, cond, self.wheel)
-            geo = effect.geometry(geo, cond, self.wheel)
+        for effect in self.effects.values():  # geometry sees the soil all effects made
+            geo = effect.geometry(geo, soil, cond, self.wheel)
         contact_forces = _ContactForces(soil, geo, cond)
         z_max = np.full(cond.slip.shape, self.wheel.radius_m)
         sinkage, residual = solve_increasing(lambda z: contact_forces(z)["fz_n"],
@@ -130,7 +138,8 @@ class WheelModel:
         out = contact_forces(sinkage)
         contact = Contact(sinkage, out["theta1_rad"], out["theta2_rad"], out["thetam_rad"],
                           out.pop("exit_shear_displacement_m"))
-        terms = {t: np.zeros(cond.slip.shape) for cls in EFFECTS.values() for t in cls.terms}
+        terms = {t: np.zeros(cond.slip.shape)
+                 for laws in LAWS.values() for cls in laws.values() for t in cls.terms}
         dp, torque = out.pop("dp_soil_n"), out.pop("torque_soil_nm")
         for effect in self.effects.values():
             extra = effect.forces(contact, soil, geo, cond, self.wheel)
@@ -140,7 +149,7 @@ class WheelModel:
             "load_n": cond.load_n, "slip": cond.slip, "multipass": cond.multipass,
             "gravity_mps2": cond.gravity_mps2, "dp_n": dp, "torque_nm": torque,
             "sinkage_m": sinkage, "resistance_n": torque / self.wheel.radius_m - dp,
-            "thrust_n": out["thrust_n"] + terms["grouser_thrust_n"],
+            "thrust_n": out["thrust_n"],
             "compaction_resistance_n": out["compaction_resistance_n"],
             "fz_n": out["fz_n"], "fz_residual_n": -residual,
             "converged": np.abs(residual) < CONVERGED_REL * cond.load_n,
@@ -172,7 +181,7 @@ class _ContactForces:
         self.k_reece = (soil.kc / b + soil.kphi) * b ** soil.n0
         self.n = soil.n0 + soil.n_slope * np.abs(cond.slip)
         self.slip = cond.slip
-        self.vel_ratio = stress.velocity_ratio(cond.slip)
+        self.skid = cond.slip < 0
 
     def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
         soil, geo, b = self.soil, self.geo, self.width
@@ -180,19 +189,23 @@ class _ContactForces:
         r_s = r_c + geo.shear_offset_m
         theta1 = np.arccos(np.clip(1.0 - sinkage_m / r_c, -1.0, 1.0))
         theta2 = 0.0 - soil.c3 * theta1  # 0.0 - : no -0.0 in the output
-        thetam = stress.max_stress_angle(theta1, theta2, self.slip, soil.c1, soil.c2)
-        theta = np.concatenate([stress.region_grid(theta2, thetam)[0],
-                                stress.region_grid(thetam, theta1)[0]], axis=-1)
-        weights = np.concatenate([stress.region_grid(theta2, thetam)[1],
-                                  stress.region_grid(thetam, theta1)[1]], axis=-1)
+        # part I (driven): theta_m = (c1 + c2 s) theta_1; part II (braked, towed): the
+        # normal stress peaks at the transition angle, where the shear changes sign
+        thetat = np.clip(stress.transition_angle(self.slip, soil.phi_rad), theta2, theta1)
+        thetam = np.where(self.skid, thetat, stress.max_stress_angle(
+            theta1, theta2, self.slip, soil.c1, soil.c2))
+        (rear, w_rear), (front, w_front) = (stress.region_grid(theta2, thetam),
+                                            stress.region_grid(thetam, theta1))
+        theta = np.concatenate([rear, front], axis=-1)
+        weights = np.concatenate([w_rear, w_front], axis=-1)
         sigma = stress.normal_stress(theta, theta1, theta2, thetam, self.k_reece, self.n, r_c, b)
-        j = stress.shear_displacement(theta, theta1, r_s, self.vel_ratio)
+        j = self._shear_displacement(theta, theta1, thetat, r_s)
         tau = stress.shear_stress(sigma, j, soil.cohesion_pa, soil.phi_rad, soil.shear_modulus_m)
         cos, sin = np.cos(theta), np.sin(theta)
         integral = lambda f: np.sum(f * weights, axis=-1)  # noqa: E731
         thrust = b * r_s * integral(tau * cos)
         compaction = b * r_c * integral(sigma * sin)
-        j_exit = stress.shear_displacement(theta2[..., None], theta1, r_s, self.vel_ratio)[..., 0]
+        j_exit = self._shear_displacement(theta2[..., None], theta1, thetat, r_s)[..., 0]
         return {
             "fz_n": b * (r_c * integral(sigma * cos) + r_s * integral(tau * sin)),
             "dp_soil_n": thrust - compaction,
@@ -201,3 +214,10 @@ class _ContactForces:
             "theta1_rad": theta1, "theta2_rad": theta2, "thetam_rad": thetam,
             "exit_shear_displacement_m": j_exit,
         }
+
+    def _shear_displacement(self, theta, theta1, thetat, r_s):
+        """j (m): part I for driven, part II for braked or towed conditions."""
+        slip = self.slip
+        driven = stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
+        braked = stress.skid_shear_displacement(theta, theta1, thetat, r_s, np.minimum(slip, 0.0))
+        return np.where(self.skid[..., None], braked, driven)

@@ -50,10 +50,11 @@ def model_from_dict(data: dict) -> WheelModel:
         if name not in EFFECTS:
             raise ModelFileError(f"[effects.{name}] unknown effect; known: {sorted(EFFECTS)}")
         params = dict(table)
+        law = params.pop("law", None)
         if params.pop("enabled", True):
             try:
-                effects[name] = make_effect(name, **params)
-            except TypeError as exc:
+                effects[name] = make_effect(name, law, **params)
+            except (TypeError, KeyError) as exc:
                 raise ModelFileError(f"[effects.{name}]: {exc}") from None
     gravity = data.get("model", {}).get("gravity_mps2", EARTH_GRAVITY_MPS2)
     return WheelModel(wheel=wheel, soil=soil, gravity_mps2=float(gravity), effects=effects)
@@ -78,11 +79,13 @@ def shipped_model(name: str) -> WheelModel:
 
 
 def model_to_dict(model: WheelModel) -> dict:
-    """The tables of a model file; effects that are off are written with enabled = false."""
+    """The tables of a model file; effects that are off are written with enabled = false
+    (with their default law)."""
     effects = {}
     for name, cls in EFFECTS.items():
-        on = name in model.effects
-        effects[name] = {"enabled": on, **dataclasses.asdict(model.effects.get(name) or cls())}
+        effect = model.effects.get(name) or cls()
+        effects[name] = {"enabled": name in model.effects, "law": effect.law,
+                         **dataclasses.asdict(effect)}
     return {"model": {"gravity_mps2": model.gravity_mps2},
             "wheel": {k: v for k, v in dataclasses.asdict(model.wheel).items()
                       if v is not None and v != ""},

@@ -33,4 +33,6 @@ class ModelLaw:
 
     def parameters(self) -> dict[str, float | str]:
         return {"name": "terramechanics.WheelModel", "soil": self.model.soil.name,
-                "effects": ",".join(self.model.effects), **self.model.parameters()}
+                "effects": ",".join(self.model.effects),
+                "laws": ",".join(f"{n}={e.law}" for n, e in self.model.effects.items()),
+                **self.model.parameters()}

@@ -37,7 +37,7 @@ def small(tmp_path_factory):
     """(database URL, report path, page text) of the small campaign, exported and reported."""
     folder = tmp_path_factory.mktemp("report")
     url = build_small_campaign(folder)
-    page = write_report(url, folder / "report.html", quiet=True)
+    page = write_report(url, folder / "report.html")
     return url, page, page.read_text(encoding="utf-8")
 
 
@@ -115,8 +115,8 @@ def test_figures_label_every_axis_with_a_unit_and_share_load_colours(small):
     for f in data.fits:
         tested.setdefault(f.quantity, []).append(f.load_n)
     figs = {
-        "timeseries": figures.run_timeseries(run, None, palette),
-        "no_stable": figures.run_timeseries(nsp, None, palette),
+        "timeseries": figures.run_timeseries(run, palette),
+        "no_stable": figures.run_timeseries(nsp, palette),
         "curves": figures.performance_curves(data.points, data.fits, *key[:2],
                                              data.source.statuses, palette),
         "interpolation": figures.load_validation(data.points, data.fits, key, 120.0,
@@ -129,8 +129,8 @@ def test_figures_label_every_axis_with_a_unit_and_share_load_colours(small):
             assert UNIT.search(ax.get_ylabel()), (name, ax.get_ylabel())
             if ax.get_xlabel() or ax is fig.axes[-1]:
                 assert UNIT.search(ax.get_xlabel()), (name, ax.get_xlabel())
-    # the stored DP trace and the reason stand in for a no-stable-phase run's raw file
-    assert "stored DP trace" in figs["no_stable"].axes[0].get_legend_handles_labels()[1]
+    # a run with no stable phase: its stored traces and the reason
+    assert "stored trace" in figs["no_stable"].axes[0].get_legend_handles_labels()[1]
     assert "digs in" in figs["no_stable"].get_suptitle()
     legend = [t.get_text() for t in figs["curves"].legends[0].get_texts()]
     assert legend == ["70 N", "120 N", "180 N", "flagged, not fitted"]
@@ -161,25 +161,25 @@ def test_time_series_shades_the_stable_window(small):
     with open_database(url)() as session:
         data = gather(session, "bb2_sand_sample")
     run = next(r for r in data.runs if r.run_id == "L070_MP0_SC_s+020")
-    fig = figures.run_timeseries(run, None, Palette(data.loads, data.multipasses))
+    fig = figures.run_timeseries(run, Palette(data.loads, data.multipasses))
     spans = [p for p in fig.axes[0].patches]
     assert len(spans) == 1
     x0, x1 = spans[0].get_x(), spans[0].get_x() + spans[0].get_width()
     assert (x0, x1) == pytest.approx((run.window_start_s, run.window_end_s))
 
 
-def test_a_raw_file_gone_since_processing_is_said_so(small, tmp_path):
+def test_a_run_processed_before_traces_were_stored_is_said_so(small):
     url, _, _ = small
     with open_database(url)() as session:
         data = gather(session, "bb2_sand_sample")
     palette = Palette(data.loads, data.multipasses)
-    nsp = next(r for r in data.runs if r.run_id == NO_STABLE_RUN)
-    moved = replace(nsp, raw_path=str(tmp_path / "moved.mcap"))
-    image = sections.timeseries_image(0, moved, palette)
-    assert "moved.mcap not readable" in image.caption
-    fig = figures.run_timeseries(moved, None, palette)
+    nsp = replace(next(r for r in data.runs if r.run_id == NO_STABLE_RUN), traces=None)
+    image = sections.timeseries_image(0, nsp, palette)
+    assert image.caption.endswith("trace not stored; re-run swtlab process")
+    fig = figures.run_timeseries(nsp, palette)
+    # its DP trace stored by processing (runs with no stable phase always had one) is shown
     assert fig.axes[0].get_legend_handles_labels()[1] == ["stored DP trace"]
-    assert [t.get_text() for t in fig.axes[1].texts] == ["raw file not readable"]
+    assert [t.get_text() for t in fig.axes[1].texts] == [figures.NOT_STORED]
 
 
 def test_without_an_export_the_curves_are_fitted_here_from_ok_runs(small, tmp_path):
@@ -206,24 +206,24 @@ def test_optional_sections_appear_only_with_data(small, tmp_path, fast_timeserie
     assert '<section id="image-slip"><h2>Image slip against encoder slip</h2>' in small[2]
     monkeypatch.setattr(extensions, "EXTENSIONS", [])  # only this test's extensions below
 
-    def with_data(session, data, palette):
+    def with_data(data, palette):
         calls.append(data.name)
         return Section("image-slip", "Image slip against encoder slip",
                        [Note(f"{len(data.runs)} runs")])
 
     with open_database(url)() as session:
         data = gather(session, "bb2_sand_sample")
-        palette = Palette(data.loads, data.multipasses)
-        assert optional_sections(session, data, palette) == []  # nothing registered
-        register(Extension("no-data", lambda session, data, palette: None))
-        register(Extension("image-slip", with_data))
-        try:
-            found = optional_sections(session, data, palette)
-            assert [s.anchor for s in found] == ["image-slip"] and calls == ["bb2_sand_sample"]
-            text = write_report(url, tmp_path / "r.html", quiet=True).read_text()
-        finally:
-            unregister("no-data")
-            unregister("image-slip")
+    palette = Palette(data.loads, data.multipasses)
+    assert optional_sections(data, palette) == []  # nothing registered
+    register(Extension("no-data", lambda data, palette: None))
+    register(Extension("image-slip", with_data))
+    try:
+        found = optional_sections(data, palette)
+        assert [s.anchor for s in found] == ["image-slip"] and calls == ["bb2_sand_sample"]
+        text = write_report(url, tmp_path / "r.html").read_text()
+    finally:
+        unregister("no-data")
+        unregister("image-slip")
     assert '<section id="image-slip"><h2>Image slip against encoder slip</h2>' in text
     assert "20 runs" in text and '<a href="#image-slip">' in text
 

@@ -125,7 +125,7 @@ def test_report_opens_in_chromium_without_errors_and_renders(tmp_path):
     runs = [f"L070_MP0_SC_s{s}.mcap" for s in ("-010", "+000", "+005", "+010", "+020", "+035",
                                                "+060")] + ["L180_MP0_SC_s+090.mcap"]
     url = build_small_campaign(tmp_path, runs=runs, export=False)
-    page = write_report(url, tmp_path / "report.html", quiet=True)
+    page = write_report(url, tmp_path / "report.html")
     found, console = probe(page, tmp_path)
     assert found["images"] == page.read_text().count("<img ") >= len(runs) * 2 + 1
     assert found["decoded"] == ["ok"] * found["images"]

@@ -9,7 +9,7 @@ from sqlalchemy import select
 
 import terramechanics as tm
 import virtual_testbed as vt
-from sim_gap.bench import FAST_DESIGN, base_model, conditions, run_bench, score
+from validation.gap_bench import FAST_DESIGN, base_model, conditions, run_bench, score
 from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import GapReport

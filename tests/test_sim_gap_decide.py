@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 
 import terramechanics as tm
+from sim_gap import candidates
 from sim_gap.decide import decide, rank
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.discriminate import separating_test
@@ -82,7 +83,7 @@ def test_without_the_contrast_the_call_is_inconclusive_with_a_test_to_run():
     report = diagnose(points, Simulated(BASE), ["grousers", "slip_sinkage"], FAST)
     assert report["verdict"] == "inconclusive"
     assert report["folds"][0].startswith("slip band")
-    assert "only 3.1 SE" in report["decision"]["reason"]
+    assert "only 3.4 SE" in report["decision"]["reason"]
     test = report["decision"]["separating_test"]
     assert test["test"] == "add skid (braked) slips (-0.5, -0.2)"
     assert test["separation_sigma"] > 2.0
@@ -142,3 +143,19 @@ def test_decide_weak_gain_and_unexplained_gap_are_inconclusive():
     out = decide(rank(_fake(big), 30), big)
     assert out["verdict"] == "inconclusive" and out.get("unexplained")
     assert "outside the candidate set" in out["reason"]
+
+
+def test_candidates_free_the_fit_parameters_their_law_declares():
+    """A candidate frees the strengths of the effect's law: the default law's when the
+    simulation does not have the effect, else the law the simulation uses."""
+    names = lambda c: [p.name for p in c.params[3:]]  # noqa: E731 (after the 3 soil ones)
+    assert names(candidates.candidate(BASE, ("grousers",))) == [
+        "effects.grousers.shear_radius_factor"]
+    lugged = BASE.with_effects(grousers={"law": "ding2011"})
+    assert names(candidates.candidate(lugged, ("grousers",))) == [
+        "effects.grousers.shear_radius_factor", "effects.grousers.lug_sinkage_gain"]
+    flex = candidates.effect_params("wheel_flexibility", "bekker1969")
+    assert [(p.name, p.lower, p.upper, p.log) for p in flex] == [
+        ("effects.wheel_flexibility.ground_pressure_pa", 2e3, 5e5, True)]
+    for p in candidates.candidate(lugged, ("grousers",)).params[3:]:  # the names resolve
+        lugged.with_parameters({p.name: p.start})

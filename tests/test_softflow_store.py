@@ -146,7 +146,7 @@ def test_frames_inside_the_window_middle_ones_when_too_many():
 def test_report_section_and_standalone_flow_of_the_stored_range(stored, campaign, tmp_path):
     with open_database(stored)() as session:
         data = gather(session, "virtual")
-        section = flow_section(session, data, Palette(data.loads, data.multipasses))
+        section = flow_section(data, Palette(data.loads, data.multipasses))
         row = session.scalars(select(SoilFlow).join(RawFile).join(Run)
                               .where(Run.run_id == "FLOW_MCAP")).one()
         stored_rates = {(f.beta_deg, f.component): f.rate_per_m for f in row.fits}

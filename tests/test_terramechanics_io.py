@@ -96,3 +96,5 @@ def test_model_as_the_virtual_testbed_law():
     params = law.parameters()
     assert params["soil"] == "bb2_sand" and params["soil.kphi"] == 1.8e7
     assert params["effects"] == "grousers,slip_sinkage,wheel_flexibility,multipass"
+    assert params["laws"] == ("grousers=bekker1956,slip_sinkage=ding2011,"
+                              "wheel_flexibility=wong2010,multipass=wong2010")

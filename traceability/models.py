@@ -18,11 +18,13 @@ class Base(DeclarativeBase):
 
 
 class ProcessingRecord(Base):
-    """Who made a row: swtlab version, pipeline stage, its parameters, when."""
+    """Who made a row: swtlab version and the sha256 of the lock file it was installed from
+    (None where there was none, e.g. a wheel install), pipeline stage, its parameters, when."""
 
     __tablename__ = "processing_record"
     id: Mapped[int] = mapped_column(primary_key=True)
     swtlab_version: Mapped[str] = mapped_column(String(40))
+    lock_sha256: Mapped[str | None] = mapped_column(String(64), nullable=True)
     stage: Mapped[str] = mapped_column(String(40))
     parameters: Mapped[dict] = mapped_column(JSON, default=dict)
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True))
@@ -186,6 +188,8 @@ class RunResult(Base):
     processing: Mapped[ProcessingRecord] = relationship()
     quantities: Mapped[list[RunQuantity]] = relationship(back_populates="result",
                                                          order_by="RunQuantity.id")
+    traces: Mapped[list[RunTrace]] = relationship(back_populates="result",
+                                                  order_by="RunTrace.id")
 
 
 class RunQuantity(Base):
@@ -204,6 +208,26 @@ class RunQuantity(Base):
     n_eff: Mapped[float | None] = mapped_column(Float, nullable=True)
 
     result: Mapped[RunResult] = relationship(back_populates="quantities")
+
+
+class RunTrace(Base):
+    """One quantity of a run result against time, decimated for plots (``run_results.traces``;
+    ``channel``: the quantity, e.g. ``dp_n``): ``samples`` raw samples, ``block`` samples per
+    min/max pair (1: kept whole), ``points`` stored; ``arrays`` is a compressed npz of ``t_s``
+    (float64, s) and ``values`` (float32, in ``unit``)."""
+
+    __tablename__ = "run_trace"
+    __table_args__ = (UniqueConstraint("run_result_id", "channel"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    run_result_id: Mapped[int] = mapped_column(ForeignKey("run_result.id"))
+    channel: Mapped[str] = mapped_column(String(60))
+    unit: Mapped[str] = mapped_column(String(20))
+    samples: Mapped[int] = mapped_column(Integer)
+    block: Mapped[int] = mapped_column(Integer)
+    points: Mapped[int] = mapped_column(Integer)
+    arrays: Mapped[bytes] = mapped_column(LargeBinary)
+
+    result: Mapped[RunResult] = relationship(back_populates="traces")
 
 
 class CurveFit(Base):

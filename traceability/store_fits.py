@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +13,7 @@ from sqlalchemy.orm import Session
 
 from plain_json import jsonable
 from traceability.models import CurveFit, RunResult, WpmExport
+from traceability.provenance import swtlab_version
 from traceability.store import new_processing_record
 
 GROUP_COLUMNS = ("wheel", "soil", "multipass", "load_n")
@@ -30,7 +30,7 @@ def _group_rows(table: pd.DataFrame, fit: Any) -> pd.DataFrame:
 
 def _fit_sha256(result_ids: list[int], fit: Any, options: dict[str, Any]) -> str:
     """Same run results (immutable rows), same quantity and options: the same fit."""
-    payload = {"swtlab": version("swtlab"), "quantity": fit.quantity, "options": options,
+    payload = {"swtlab": swtlab_version(), "quantity": fit.quantity, "options": options,
                "group": [fit.wheel, fit.soil, int(fit.multipass), float(fit.load_n)],
                "run_results": sorted(result_ids)}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()

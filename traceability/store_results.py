@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
@@ -12,13 +11,15 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 
 from plain_json import jsonable
+from traceability.provenance import swtlab_version
 from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
 from traceability.store import new_processing_record
+from traceability.store_traces import store_traces
 
 
 def params_sha256(parameters: dict[str, Any]) -> str:
     """Hash of the processing parameters and the swtlab version (canonical JSON)."""
-    text = json.dumps({"swtlab": version("swtlab"), **parameters}, sort_keys=True, default=str)
+    text = json.dumps({"swtlab": swtlab_version(), **parameters}, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -37,7 +38,8 @@ def processed_file(session: Session, path: Path, sha256: str, params_hash: str) 
 
 def store_run_result(session: Session, raw_file: RawFile, result: Any,
                      parameters: dict[str, Any]) -> RunResult:
-    """Store ``result`` (a ``run_results.RunResult``) and its window, one processing record."""
+    """Store ``result`` (a ``run_results.RunResult``), its window and its decimated traces,
+    one processing record."""
     record = new_processing_record(session, "process", parameters)
     w = result.window
     window = StableWindow(raw_file_id=raw_file.id, found=w.found, start_s=w.start_s,
@@ -54,6 +56,7 @@ def store_run_result(session: Session, raw_file: RawFile, result: Any,
                                 for name, q in result.quantities.items()])
     session.add(row)
     session.flush()
+    store_traces(session, row, result.traces)
     return row
 
 

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from importlib.metadata import version
 from pathlib import Path
 
 import pandas as pd
@@ -70,9 +69,10 @@ def fit_curves(campaign_or_results: Campaign | pd.DataFrame, degree: int | str =
 def export_wpm(curves: Curves, path: str | Path, created: str | None = None) -> str:
     """Write ``curves`` as a WPM CSV (docs/wpm-csv.md, with each wheel's geometry) to
     ``path``, atomically; returns the file's sha256."""
+    from traceability.provenance import swtlab_version
     from wpm_export import write_wpm_csv
 
-    return write_wpm_csv(curves.fits, path, curves.inputs_sha256, version("swtlab"), created,
+    return write_wpm_csv(curves.fits, path, curves.inputs_sha256, swtlab_version(), created,
                          curves.wheels)
 
 

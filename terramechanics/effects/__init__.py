@@ -1,30 +1,63 @@
-"""Switchable physical effects, one per module, named by a fixed vocabulary.
+"""Switchable physical effects, each a family of published laws, one module per law.
 
-The names in :data:`EFFECTS` are the ones the sim-to-real diagnosis uses:
-``grousers``, ``slip_sinkage``, ``reduced_gravity``, ``wheel_flexibility``,
-``multipass``, ``bulldozing``.
+The effect names are the vocabulary the sim-to-real diagnosis uses: ``grousers``,
+``slip_sinkage``, ``reduced_gravity``, ``wheel_flexibility``, ``multipass``,
+``bulldozing``. A model picks the law of each effect (``[effects.grousers] law =
+"ding2011"`` in a model file); :data:`DEFAULT_LAWS` says which one a model without
+``law`` gets. :data:`EFFECTS` maps each effect to its default law's class.
 """
 
 from __future__ import annotations
 
-from terramechanics.effects.base import Effect
-from terramechanics.effects.bulldozing import Bulldozing
-from terramechanics.effects.grousers import Grousers
-from terramechanics.effects.multipass import Multipass
-from terramechanics.effects.reduced_gravity import ReducedGravity
-from terramechanics.effects.slip_sinkage import SlipSinkage
-from terramechanics.effects.wheel_flexibility import WheelFlexibility
+from terramechanics.effects.base import Effect, FitParam
+from terramechanics.effects.bulldozing_bekker1969 import BulldozingBekker1969
+from terramechanics.effects.bulldozing_rankine_terzaghi1943 import BulldozingRankineTerzaghi1943
+from terramechanics.effects.grousers_bekker1956 import GrousersBekker1956
+from terramechanics.effects.grousers_ding2011 import GrousersDing2011
+from terramechanics.effects.multipass_krenn_hirzinger2009 import MultipassKrennHirzinger2009
+from terramechanics.effects.multipass_wong2010 import MultipassWong2010
+from terramechanics.effects.reduced_gravity_reece1965 import ReducedGravityReece1965
+from terramechanics.effects.reduced_gravity_wong_kobayashi2012 import (
+    ReducedGravityWongKobayashi2012)
+from terramechanics.effects.slip_sinkage_ding2011 import SlipSinkageDing2011
+from terramechanics.effects.slip_sinkage_lyasko2010 import SlipSinkageLyasko2010
+from terramechanics.effects.wheel_flexibility_bekker1969 import WheelFlexibilityBekker1969
+from terramechanics.effects.wheel_flexibility_wong2010 import WheelFlexibilityWong2010
 
-EFFECTS: dict[str, type[Effect]] = {cls.name: cls for cls in (
-    Grousers, SlipSinkage, ReducedGravity, WheelFlexibility, Multipass, Bulldozing)}
+_ALL: tuple[type[Effect], ...] = (
+    GrousersBekker1956, GrousersDing2011, SlipSinkageDing2011, SlipSinkageLyasko2010,
+    ReducedGravityWongKobayashi2012, ReducedGravityReece1965, WheelFlexibilityWong2010,
+    WheelFlexibilityBekker1969, MultipassWong2010, MultipassKrennHirzinger2009,
+    BulldozingBekker1969, BulldozingRankineTerzaghi1943)
+
+#: effect -> law -> class, effects in the vocabulary's order
+LAWS: dict[str, dict[str, type[Effect]]] = {}
+for _cls in _ALL:
+    LAWS.setdefault(_cls.name, {})[_cls.law] = _cls
+
+#: the law a model gets when it names none
+DEFAULT_LAWS: dict[str, str] = {
+    "grousers": "bekker1956", "slip_sinkage": "ding2011",
+    "reduced_gravity": "wong_kobayashi2012", "wheel_flexibility": "wong2010",
+    "multipass": "wong2010", "bulldozing": "bekker1969"}
+
+EFFECTS: dict[str, type[Effect]] = {name: LAWS[name][DEFAULT_LAWS[name]] for name in LAWS}
 
 
-def make_effect(name: str, **params: float) -> Effect:
-    """Build the effect called ``name`` with its parameters (defaults for the others)."""
-    if name not in EFFECTS:
-        raise KeyError(f"unknown effect {name!r}; known: {sorted(EFFECTS)}")
-    return EFFECTS[name](**params)
+def law_class(name: str, law: str | None = None) -> type[Effect]:
+    """The class of ``law`` of effect ``name`` (its default law when ``law`` is None)."""
+    if name not in LAWS:
+        raise KeyError(f"unknown effect {name!r}; known: {sorted(LAWS)}")
+    law = DEFAULT_LAWS[name] if law is None else law
+    if law not in LAWS[name]:
+        raise KeyError(f"unknown law {law!r} of effect {name!r}; known: {sorted(LAWS[name])}")
+    return LAWS[name][law]
 
 
-__all__ = ["EFFECTS", "Effect", "make_effect", "Bulldozing", "Grousers", "Multipass",
-           "ReducedGravity", "SlipSinkage", "WheelFlexibility"]
+def make_effect(name: str, law: str | None = None, **params: float) -> Effect:
+    """Build ``law`` of effect ``name`` (default law if None) with its parameters."""
+    return law_class(name, law)(**params)
+
+
+__all__ = ["DEFAULT_LAWS", "EFFECTS", "Effect", "FitParam", "LAWS", "law_class",
+           "make_effect"] + [cls.__name__ for cls in _ALL]

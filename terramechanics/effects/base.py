@@ -1,27 +1,45 @@
-"""The tiny protocol every effect follows: three hooks, each an identity by default."""
+"""The tiny protocol every effect law follows: three hooks, each an identity by default."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import ClassVar
 
 from terramechanics.state import Condition, Contact, ExtraForces, Geometry, SoilState
 from terramechanics.wheel import Wheel
 
 
-class Effect:
-    """Base of the effects; a subclass is a frozen dataclass of its parameters.
+@dataclass(frozen=True)
+class FitParam:
+    """A parameter of a law that a fit may free: its start value, bounds, log scale or not."""
 
-    ``soil`` and ``geometry`` change what the stress integrals see (and so the
-    sinkage); ``forces`` adds forces outside the integrals once the sinkage is solved.
+    name: str
+    start: float
+    lower: float
+    upper: float
+    log: bool = False
+
+
+class Effect:
+    """Base of the effect laws; a subclass is a frozen dataclass of its parameters.
+
+    ``name`` is the effect (the diagnosis vocabulary), ``law`` the published law that
+    implements it (one module per law, named after its source). ``soil`` and
+    ``geometry`` change what the stress integrals see (and so the sinkage); ``forces``
+    adds forces outside the integrals once the sinkage is solved. ``fit`` lists the
+    strength parameters a gap fit frees, with their bounds.
     """
 
     name: ClassVar[str]
+    law: ClassVar[str]
     terms: ClassVar[tuple[str, ...]] = ()  # names of the extra outputs of `forces`
+    fit: ClassVar[tuple[FitParam, ...]] = ()
 
     def soil(self, soil: SoilState, cond: Condition, wheel: Wheel) -> SoilState:
         return soil
 
-    def geometry(self, geo: Geometry, cond: Condition, wheel: Wheel) -> Geometry:
+    def geometry(self, geo: Geometry, soil: SoilState, cond: Condition,
+                 wheel: Wheel) -> Geometry:
         return geo
 
     def forces(self, contact: Contact, soil: SoilState, geo: Geometry, cond: Condition,

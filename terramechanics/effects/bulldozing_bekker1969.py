@@ -1,4 +1,4 @@
-"""Bulldozing resistance of the soil pushed ahead of the wheel.
+"""Bulldozing after Bekker: the soil wedge pushed ahead of the wheel.
 
 Bekker (1969) "Introduction to terrain-vehicle systems", after Hegedus (1960),
 as given by Wong (Theory of Ground Vehicles, 4th ed. 2008, ch. 2, bulldozing resistance)::
@@ -9,7 +9,10 @@ as given by Wong (Theory of Ground Vehicles, 4th ed. 2008, ch. 2, bulldozing res
     K_c = (N_c - tan phi) cos^2 phi,  K_g = (2 N_g / tan phi + 1) cos^2 phi
 
 Terzaghi's N_q and N_c, Vesic's (1973) N_g = 2 (N_q + 1) tan phi. It lowers the
-drawbar pull at the same torque. ``coefficient`` scales it (1 = the formula).
+drawbar pull at the same torque. ``coefficient`` scales it (1 = the formula). Derived
+for a vertical blade of the rut depth (Hegedus' bulldozing blade), fitted to tyres of
+off-road vehicles in soft soil; for small ruts in cohesive-frictional soil it gives tens
+of newtons, more than small planetary wheels show (hence the coefficient).
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from terramechanics.effects.base import Effect
+from terramechanics.effects.base import Effect, FitParam
 from terramechanics.state import ExtraForces
 
 
@@ -50,12 +53,14 @@ def bulldozing_resistance_n(sinkage_m, diameter_m, width_m, cohesion_pa, phi_rad
 
 
 @dataclass(frozen=True)
-class Bulldozing(Effect):
+class BulldozingBekker1969(Effect):
     """``coefficient``: multiplier on Bekker's bulldozing resistance (1 = as published)."""
 
     coefficient: float = 1.0
     name = "bulldozing"
+    law = "bekker1969"
     terms = ("bulldozing_n",)
+    fit = (FitParam("coefficient", 0.5, 0.0, 5.0),)
 
     def forces(self, contact, soil, geo, cond, wheel):
         r_b = self.coefficient * bulldozing_resistance_n(

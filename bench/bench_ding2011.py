@@ -1,0 +1,79 @@
+"""Accuracy on Ding et al. (2011) smooth and 10 mm lug wheels at 80 N (issue 15 item 4).
+
+Target: DP median |error| <= 15 %, sinkage <= 25 %, with the published soil. Settings:
+``published`` uses Ding's Table 2 soil as it is; ``static_k`` scales kc and kphi by the
+one factor that matches the smooth wheel's zero-slip sinkage (that point only). Laws:
+``lyasko2010`` slip-sinkage and ``bekker1956`` grousers have no constant fitted here
+(every point held out); ``ding2011`` slip-sinkage fits n1 on the smooth wheel (its
+smooth numbers are in-sample, the lug wheel is held out); ``ding2011`` grousers fit
+the lug-sinkage gain on the lug wheel (in-sample, marked ``fit``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from terramechanics import ding2011
+from terramechanics.model import WheelModel
+
+TARGET = {"dp_median_rel": 0.15, "sinkage_median_rel": 0.25}
+
+
+def _sinkage_sse(model: WheelModel, points, name: str) -> float:
+    p = ding2011.predict(model, points, name)
+    return float(np.sum((p["sinkage_m"] / p["sinkage_meas_m"] - 1) ** 2))
+
+
+def _fit(make, points, name: str, upper: float) -> float:
+    """The constant of ``make(value) -> model`` that best fits the sinkage of ``name``."""
+    res = minimize_scalar(lambda v: _sinkage_sse(make(v), points, name), bounds=(0.0, upper),
+                          method="bounded", options={"xatol": 1e-3})
+    return float(res.x)
+
+
+def cases(base: WheelModel, points) -> list[tuple[str, str, WheelModel, str]]:
+    """(label, wheel, model, what was fitted) for one soil setting."""
+    n1 = _fit(lambda v: base.with_effects(slip_sinkage={"n1": v}), points, "smooth", 2.0)
+    ding = base.with_effects(slip_sinkage={"n1": n1})
+    gain = _fit(lambda v: ding.with_effects(grousers={"law": "ding2011", "lug_sinkage_gain": v}),
+                points, "lug10", 40.0)
+    lyasko = base.with_effects(slip_sinkage={"law": "lyasko2010"})
+    return [
+        ("plain Bekker-Wong", "smooth", base, "-"),
+        ("plain Bekker-Wong", "lug10", base, "-"),
+        ("+ grousers bekker1956", "lug10", base.with_effects(grousers=True), "-"),
+        ("slip_sinkage ding2011", "smooth", ding, f"fit n1={n1:.3f}"),
+        ("slip_sinkage ding2011 + grousers bekker1956", "lug10",
+         ding.with_effects(grousers=True), f"n1={n1:.3f} from smooth"),
+        ("slip_sinkage ding2011 + grousers ding2011", "lug10",
+         ding.with_effects(grousers={"law": "ding2011", "lug_sinkage_gain": gain}),
+         f"fit gain={gain:.2f}"),
+        ("slip_sinkage lyasko2010", "smooth", lyasko, "-"),
+        ("slip_sinkage lyasko2010 + grousers bekker1956", "lug10",
+         lyasko.with_effects(grousers=True), "-"),
+    ]
+
+
+def settings(points) -> dict[str, WheelModel]:
+    published = WheelModel(ding2011.wheel(points, "smooth"), ding2011.SOIL)
+    factor = ding2011.static_stiffness_factor(published, points)
+    soil = published.soil
+    return {"published": published,
+            f"static_k (kc, kphi x {factor:.2f})": published.with_soil(
+                kc=soil.kc * factor, kphi=soil.kphi * factor)}
+
+
+def main(quick: bool = False) -> dict:
+    points = ding2011.load_points()
+    numbers: dict = {"target": TARGET}
+    print(f"{'soil':<30}{'model':<46}{'wheel':<8}{'DP med':>8}{'z med':>8}  fitted")
+    for setting, base in settings(points).items():
+        for label, name, model, fitted in cases(base, points):
+            err = ding2011.errors(model, points, name)
+            numbers[f"{setting} | {label} | {name}"] = {**err, "fitted": fitted}
+            print(f"{setting:<30}{label:<46}{name:<8}{err['dp_median_rel']:>8.1%}"
+                  f"{err['sinkage_median_rel']:>8.1%}  {fitted}")
+    print(f"target: DP <= {TARGET['dp_median_rel']:.0%}, sinkage <= "
+          f"{TARGET['sinkage_median_rel']:.0%}")
+    return numbers

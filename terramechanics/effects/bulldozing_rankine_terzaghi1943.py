@@ -1,0 +1,44 @@
+"""Bulldozing as the Rankine passive earth pressure on the front of the rut.
+
+Terzaghi (1943) "Theoretical soil mechanics", ch. 4 (Rankine's passive state, 1857):
+a smooth vertical wall of height z pushed into a cohesive-frictional soil meets, per
+width, ``P_p = gamma z^2 N_phi / 2 + 2 c z sqrt(N_phi)``, ``N_phi = tan^2(45 deg +
+phi/2)``. Taking the wall as the rut front of depth z (the wheel sinkage) and the
+wheel width b: ``R_b = b P_p``, subtracted from the drawbar pull (passive earth
+pressure as in Wong, Theory of Ground Vehicles 2008, ch. 2). Rankine's wall has no
+wall friction and a plane failure surface, and the rut front is taken vertical: for
+shallow ruts this is far smaller than Bekker's curved-front formula
+(``bulldozing_bekker1969``, which adds the wedge ahead of the front); it holds for
+ruts shallow against the radius. ``coefficient`` scales it (1 = the formula).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from terramechanics.effects.base import Effect, FitParam
+from terramechanics.state import ExtraForces
+
+
+def rankine_passive_n_m(depth_m, cohesion_pa, phi_rad, gamma_n_m3):
+    """Rankine passive force per width (N/m) on a vertical wall of height ``depth_m``."""
+    n_phi = np.tan(np.pi / 4 + phi_rad / 2) ** 2
+    return 0.5 * gamma_n_m3 * depth_m**2 * n_phi + 2 * cohesion_pa * depth_m * np.sqrt(n_phi)
+
+
+@dataclass(frozen=True)
+class BulldozingRankineTerzaghi1943(Effect):
+    """``coefficient``: multiplier on the Rankine passive resistance (1 = as published)."""
+
+    coefficient: float = 1.0
+    name = "bulldozing"
+    law = "rankine_terzaghi1943"
+    terms = ("bulldozing_n",)
+    fit = (FitParam("coefficient", 0.5, 0.0, 5.0),)
+
+    def forces(self, contact, soil, geo, cond, wheel):
+        r_b = self.coefficient * wheel.width_m * rankine_passive_n_m(
+            contact.sinkage_m, soil.cohesion_pa, soil.phi_rad, soil.unit_weight_n_m3)
+        return ExtraForces(dp_n=-r_b, terms={"bulldozing_n": r_b})
