@@ -55,7 +55,8 @@ class Simulated:
         out = {q: np.full(len(points), np.nan) for q in QUANTITIES}
         for mp, idx in points.groupby("multipass").indices.items():
             sub = points.iloc[idx]
-            values = self.wpm.at_slip(sub["slip"].to_numpy(float), sub["wheel_load_n"].to_numpy(float),
+            values = self.wpm.at_slip(sub["slip"].to_numpy(float),
+                                      sub["wheel_load_n"].to_numpy(float),
                                       multipass=int(mp), allow_extrapolation=True)
             for q, v in values.items():
                 if q in out:
@@ -63,7 +64,8 @@ class Simulated:
         return out
 
     def _base(self, points: pd.DataFrame) -> tuple[dict, dict]:
-        key = points[["wheel_load_n", "slip", "multipass", "gravity_mps2"]].to_numpy(float).tobytes()
+        key = points[["wheel_load_n", "slip", "multipass",
+                      "gravity_mps2"]].to_numpy(float).tobytes()
         if key not in self._base_cache:
             self._base_cache.clear()
             model0 = self._model_curves(self.model, points)

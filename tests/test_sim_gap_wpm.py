@@ -52,8 +52,9 @@ def test_wpm_simulation_adds_effects_as_model_corrections(tmp_path):
     np.testing.assert_allclose(plain["dp_n"], direct["dp_n"], atol=0.05)
     values = {"effects.bulldozing.coefficient": 1.0}
     with_effect = sim.predict(points, values)
-    correction = (BASE.with_parameters(values).curves(points["wheel_load_n"], points["slip"])["dp_n"]
-                  - BASE.curves(points["wheel_load_n"], points["slip"])["dp_n"])
+    load, slip = points["wheel_load_n"], points["slip"]
+    correction = (BASE.with_parameters(values).curves(load, slip)["dp_n"]
+                  - BASE.curves(load, slip)["dp_n"])
     np.testing.assert_allclose(with_effect["dp_n"] - plain["dp_n"], correction, atol=1e-9)
     assert np.all(correction < -1.0)                 # bulldozing costs drawbar pull
 
