@@ -29,6 +29,7 @@ from run_results.traces import run_traces
 from softflow.track_run import run_image_slip
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
+from swtlab.domain.results import wheel_columns
 
 FORCE_CHANNELS = ("fx_n", "fy_n", "fz_n", "tx_nm", "ty_nm", "tz_nm", "dp_n")
 #: a measured passing frequency this far from n*omega/2pi is flagged
@@ -38,7 +39,7 @@ DP_TRACE_POINTS = 500
 
 def _condition(run) -> dict:
     info = run.metadata.run
-    return {"campaign": info.campaign, "wheel": info.wheel, "soil": info.soil,
+    return {"campaign": info.campaign, **wheel_columns(run.metadata.wheel), "soil": info.soil,
             "multipass": info.multipass, "load_n": info.load_n,
             "slip_setpoint": info.slip_setpoint, "velocity_mps": info.velocity_mps,
             "steer_deg": info.steer_deg, "gravity_mps2": info.gravity_mps2}

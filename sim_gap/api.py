@@ -1,27 +1,29 @@
-"""From inputs to a written report: the one call the CLI and the bench make."""
+"""Measured points and a simulation -> the gap report (after the wheel check) -> files; what
+``swtlab.diagnose_gap`` (and through it ``swtlab gap``) calls."""
 
 from __future__ import annotations
 
 from dataclasses import asdict
-from pathlib import Path
+
+import pandas as pd
 
 from sim_gap.diagnose import Settings, diagnose
-from sim_gap.measured import load_measured
-from sim_gap.report import build_report, write_json
-from sim_gap.simulated import load_simulated
+from sim_gap.report import build_report
+from sim_gap.simulated import Simulated
+from sim_gap.wheel_check import check_wheels
 
 
-def run_gap(measured: str, sim: str, json_path: str | Path | None = None,
-            effects: list[str] | None = None,
-            reference_model: str | None = None, settings: Settings | None = None) -> dict:
-    """Diagnose ``measured`` (database URL, WPM CSV or CMU smooth_runs.csv) against ``sim``
-    (model TOML or WPM CSV); write the JSON report when ``json_path`` is given. The HTML
-    page: ``campaign_report.gap.write_gap_page(report, path)``."""
+def gap_report(points: pd.DataFrame, simulated: Simulated, measured_label: str,
+               sim_label: str, effects: list[str] | None = None,
+               settings: Settings | None = None, allow_wheel_mismatch: bool = False) -> dict:
+    """The report dict of measured ``points`` against ``simulated``, after checking that they
+    are one wheel (``allow_wheel_mismatch`` goes on and records the differences)."""
     settings = settings or Settings()
-    points = load_measured(measured)
-    simulated = load_simulated(sim, reference_model)
-    report = build_report(diagnose(points, simulated, effects, settings), measured, sim,
-                          asdict(settings))
-    if json_path:
-        write_json(report, json_path)
+    mismatches = check_wheels(points, simulated, allow_wheel_mismatch)
+    report = build_report(diagnose(points, simulated, effects, settings), measured_label,
+                          sim_label, asdict(settings))
+    measured = points.attrs.get("wheel")
+    report["wheel"] = {"measured": None if measured is None else measured.geometry(),
+                       "simulated": simulated.wheel.geometry(), "mismatches": mismatches}
     return report
+

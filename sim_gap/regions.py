@@ -40,15 +40,16 @@ def _normaliser(q: str, load: np.ndarray, radius_m: float) -> np.ndarray:
 
 
 def residual_map(points: pd.DataFrame, as_given: dict[str, np.ndarray],
-                 soil_recalibrated: dict[str, np.ndarray], radius_m: float = 0.125) -> list[dict]:
+                 soil_recalibrated: dict[str, np.ndarray], radius_m: float) -> list[dict]:
     """One entry per region and quantity: mean residual (measured - simulated, SI and over
     load), its z and chi-square p-value with the uncertainty ``SE (+) repeatability floor``,
-    significance after BH, for the simulation as given and after soil-only recalibration."""
+    significance after BH, for the simulation as given and after soil-only recalibration.
+    ``radius_m``: the wheel's radius (normalises torque and sinkage)."""
     sig = sigmas(points, radius_m)
     keys = pd.DataFrame({"slip_band": np.array(slip_band_labels())[
         slip_band(points["slip"].to_numpy(float))], "load_n": points["load_set_n"].round(1),
         "multipass": points["multipass"], "gravity_mps2": points["gravity_mps2"].round(3)})
-    load = points["load_n"].to_numpy(float)
+    load = points["wheel_load_n"].to_numpy(float)
     rows = []
     for key, idx in keys.groupby(list(keys.columns), sort=True).indices.items():
         for q in quantities_of(points):

@@ -34,6 +34,11 @@ class Simulated:
     def radius_m(self) -> float:
         return self.model.wheel.radius_m
 
+    @property
+    def wheel(self):
+        """The simulated wheel (a WPM CSV's, which the reference model was given)."""
+        return self.model.wheel
+
     def missing_effects(self) -> list[str]:
         """Effects of the vocabulary that the simulation does not have on (the candidates).
         A WPM simulator is taken to have none of them."""
@@ -41,7 +46,7 @@ class Simulated:
         return [name for name in tm.EFFECTS if name not in on]
 
     def _model_curves(self, model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
-        c = model.curves(points["load_n"].to_numpy(float), points["slip"].to_numpy(float),
+        c = model.curves(points["wheel_load_n"].to_numpy(float), points["slip"].to_numpy(float),
                          points["multipass"].to_numpy(float),
                          points["gravity_mps2"].to_numpy(float))
         return {q: c[q] for q in QUANTITIES}
@@ -50,7 +55,8 @@ class Simulated:
         out = {q: np.full(len(points), np.nan) for q in QUANTITIES}
         for mp, idx in points.groupby("multipass").indices.items():
             sub = points.iloc[idx]
-            values = self.wpm.at_slip(sub["slip"].to_numpy(float), sub["load_n"].to_numpy(float),
+            values = self.wpm.at_slip(sub["slip"].to_numpy(float),
+                                      sub["wheel_load_n"].to_numpy(float),
                                       multipass=int(mp), allow_extrapolation=True)
             for q, v in values.items():
                 if q in out:
@@ -58,7 +64,8 @@ class Simulated:
         return out
 
     def _base(self, points: pd.DataFrame) -> tuple[dict, dict]:
-        key = points[["load_n", "slip", "multipass", "gravity_mps2"]].to_numpy(float).tobytes()
+        key = points[["wheel_load_n", "slip", "multipass",
+                      "gravity_mps2"]].to_numpy(float).tobytes()
         if key not in self._base_cache:
             self._base_cache.clear()
             model0 = self._model_curves(self.model, points)
@@ -82,7 +89,8 @@ class Simulated:
 
 def load_simulated(source: str | Path, reference: str | Path | None = None) -> Simulated:
     """A model TOML, or a WPM CSV with ``reference`` (a model TOML; default: the shipped
-    ``bb2_sand`` soil and wheel with every effect off) computing the corrections."""
+    ``bb2_sand`` soil with every effect off) computing the corrections. The reference model
+    takes the WPM CSV's wheel (its geometry header is required: one wheel)."""
     path = Path(source)
     if path.suffix.lower() == ".toml":
         return Simulated(tm.load_model(path), source=str(path))
@@ -91,4 +99,12 @@ def load_simulated(source: str | Path, reference: str | Path | None = None) -> S
     else:
         ref = tm.shipped_model("bb2_sand")
         ref = ref.with_effects(**{name: False for name in tm.EFFECTS})
-    return Simulated(ref, WheelPerformanceModule.load(path), source=str(path))
+    wpm = WheelPerformanceModule.load(path)
+    names = sorted({wheel for _, wheel, _ in wpm.sets()})
+    if len(names) != 1:
+        raise ValueError(f"{path}: curves of {len(names)} wheels {names}; a simulation is "
+                         "one wheel's")
+    wheel = wpm.wheel(names[0], needed_for="the gap diagnosis")
+    return Simulated(ref.with_wheel(**{k: getattr(wheel, k) for k in (
+        "name", "radius_m", "width_m", "grouser_count", "grouser_height_m")}), wpm,
+                     source=str(path))

@@ -31,13 +31,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
     p.add_argument("--boot", type=int, default=200, help="bootstrap replicates (default 200)")
     p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
+    p.add_argument("--allow-wheel-mismatch", action="store_true",
+                   help="diagnose even when the measured wheel is not the simulated one "
+                        "(radius, width, grousers); the differences go into the report")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim_gap.api import run_gap
-    from sim_gap.diagnose import Settings
     from sim_gap.vocabulary import EFFECT_NAMES
+    from swtlab.pipeline.gap import diagnose_gap
 
     effects = None
     if args.effects:
@@ -48,21 +50,23 @@ def run(args: argparse.Namespace) -> int:
                   file=sys.stderr)
             return exit_codes.USAGE
     try:
-        report = run_gap(args.measured, args.sim, args.json, effects, args.reference_model,
-                         Settings(n_boot=args.boot, jobs=args.jobs, seed=args.seed))
-        if args.html:
-            from campaign_report.gap import write_gap_page
-
-            write_gap_page(report, args.html)
+        gap = diagnose_gap(args.measured, args.sim, effects=effects,
+                           reference_model=args.reference_model, n_boot=args.boot,
+                           jobs=args.jobs, seed=args.seed,
+                           allow_wheel_mismatch=args.allow_wheel_mismatch)
+        gap.write(args.json, args.html)
     except (OSError, ValueError, KeyError) as exc:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
+    report = gap.to_dict()
     if "://" in args.measured:  # measured from a database: the report is recorded there too
         from traceability import open_database
         from traceability.store_gap import store_gap_report
 
         with open_database(args.measured).begin() as session:
             store_gap_report(session, report)
+    for line in report["wheel"]["mismatches"]:
+        print(f"wheel mismatch allowed: {line}")
     verdict = report["verdict"]
     print("verdict:", verdict if isinstance(verdict, str) else (", ".join(verdict) or "none"))
     print("reason:", report["reason"])

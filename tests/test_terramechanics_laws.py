@@ -149,7 +149,8 @@ def test_rankine_bulldozing_hand_calculation():
     on = model.with_effects(bulldozing={"law": "rankine_terzaghi1943"}).curves(180.0, 0.3)
     z, phi = on["sinkage_m"], np.radians(31.1)
     n_phi = np.tan(np.radians(45) + phi / 2) ** 2
-    hand = 0.112 * (0.5 * 1600 * 9.81 * z**2 * n_phi + 2 * 1300 * z * np.sqrt(n_phi))
+    # gamma = rho g0 (the soil parameters hold at standard gravity, 9.80665 m/s^2)
+    hand = 0.112 * (0.5 * 1600 * 9.80665 * z**2 * n_phi + 2 * 1300 * z * np.sqrt(n_phi))
     assert on["bulldozing_n"] == pytest.approx(hand, rel=1e-12)
     assert model.curves(180.0, 0.3)["dp_n"] - on["dp_n"] == pytest.approx(hand, rel=1e-9)
 

@@ -108,7 +108,7 @@ def test_suspension_angle_gives_the_sinkage():
     sus = Suspension(arm_length_m=0.6, angle_zero_rad=0.05)
     rigid = suspension_angle_rad(0.02, 180.0, replace(BB2_WHEEL, stiffness_n_per_mm=None), sus)
     assert -0.6 * (np.sin(rigid) - np.sin(0.05)) == pytest.approx(0.02)
-    flexible = Wheel("flex", 0.125, 0.112, 12, 0.0092, stiffness_n_per_mm=60.0)
+    flexible = Wheel(0.125, 0.112, 12, 0.0092, stiffness_n_per_mm=60.0, name="flex")
     angle = suspension_angle_rad(0.02, 180.0, flexible, sus)
     hub_height = 0.6 * (np.sin(angle) - np.sin(0.05))
     assert -hub_height - 180.0 / (1000.0 * 60.0) == pytest.approx(0.02)

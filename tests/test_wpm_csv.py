@@ -173,3 +173,42 @@ def test_the_example_of_the_format_page_reads_and_evaluates_as_stated():
     assert curves[0].evaluate(0.2) == pytest.approx(13.11, abs=0.005)
     assert curves[0].evaluate(-0.05) == pytest.approx(-7.52, abs=0.005)  # braked branch
     assert (curves[3].step_below_zero, curves[3].slope_below_zero) == (0.0, 0.0)
+
+
+GEOMETRY = ('# wheel_geometry: {"bb2": {"radius_m": 0.125, "width_m": 0.112, "grouser_count": 12, '
+            '"grouser_height_m": 0.0092, "stiffness_n_per_mm": null}}')
+
+
+def test_wheel_geometry_round_trips_and_old_files_still_read(tmp_path, table, fits):
+    from swtlab.domain import Wheel
+    from wpm_export import WheelPerformanceModule
+
+    wheel = Wheel(0.125, 0.112, 12, 0.0092, stiffness_n_per_mm=30.0, name=fits[0].wheel)
+    write_wpm_csv(fits, tmp_path / "new.csv", inputs_sha256(table), "0.1.0",
+                  wheels={wheel.name: wheel})
+    assert WheelPerformanceModule.load(tmp_path / "new.csv").wheel() == wheel
+    write_wpm_csv(fits, tmp_path / "old.csv", inputs_sha256(table), "0.1.0")
+    old = WheelPerformanceModule.load(tmp_path / "old.csv")
+    dp = next(f for f in fits if f.quantity == "dp_n")
+    assert old.wheels == {}   # every WPM query still answers
+    assert old.at_slip(0.2, dp.load_n, multipass=dp.multipass)["dp_n"] == pytest.approx(
+        dp.evaluate(0.2), rel=1e-12)
+    with pytest.raises(ValueError, match="no wheel geometry .* needs wheel"):
+        old.wheel(needed_for="the gap diagnosis")
+    with pytest.raises(ValueError, match="no geometry for wheel"):
+        write_wpm_csv(fits, tmp_path / "x.csv", inputs_sha256(table), "0.1.0", wheels={})
+
+
+@pytest.mark.parametrize("line, problem", [
+    ("# wheel_geometry: {bb2}", "wheel_geometry is not JSON"),
+    (GEOMETRY.replace(', "stiffness_n_per_mm": null', ""), r"missing \['stiffness_n_per_mm'\]"),
+    (GEOMETRY.replace("0.125", "-0.125"), "radius_m -0.125 must be > 0"),
+    (GEOMETRY.replace('"bb2"', '"other"'), r"lacks wheel\(s\) \['bb2'\]"),
+])
+def test_malformed_wheel_geometry_names_the_line(tmp_path, line, problem):
+    from wpm_export import parse_wpm_csv
+
+    text = ("# format: swtlab-wpm/1\n" + line + "\n" + ",".join(COLUMNS) + "\n"
+            "sand,bb2,0,70.0,dp_n,N,3,-0.1,0.6,1,2,3,4,,,,,7,0.1\n")
+    with pytest.raises(WpmFormatError, match=f"<t>:2: .*{problem}"):
+        parse_wpm_csv(text, "<t>")

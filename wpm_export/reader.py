@@ -4,13 +4,15 @@ a :class:`WpmFormatError` naming file, line and problem, never a silently differ
 from __future__ import annotations
 
 import csv
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from fitting.curve import DEGREES, PowerCurve
+from swtlab.domain import Wheel
 from wpm_export.schema import (BRANCH_COLUMNS, COEFFICIENT_COLUMNS, COLUMNS, FORMAT, UNITS,
-                               WpmFormatError)
+                               WHEEL_GEOMETRY_KEY, WHEEL_KEYS, WpmFormatError)
 
 
 @dataclass(frozen=True)
@@ -88,9 +90,38 @@ def _curve(fields: list[str], problem, line: int, columns: tuple[str, ...]) -> W
                     quantity=quantity, unit=row["unit"], n_points=n_points, rmse=rmse, line=line)
 
 
+def wheel_geometry(header: dict[str, str], path="<text>", line: int = 0) -> dict[str, Wheel]:
+    """Wheel name -> :class:`swtlab.domain.Wheel` from the header key ``wheel_geometry``
+    (empty for a file without it: older files and other tools' may lack it)."""
+    text = header.get(WHEEL_GEOMETRY_KEY)
+    if text is None:
+        return {}
+    try:
+        table = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY} is not JSON: {exc}") from None
+    if not isinstance(table, dict) or not all(isinstance(v, dict) for v in table.values()):
+        raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY} must map each wheel name to "
+                                         f"its {', '.join(WHEEL_KEYS)}")
+    out = {}
+    for name, values in table.items():
+        missing = [k for k in WHEEL_KEYS if k not in values]
+        unknown = sorted(set(values) - set(WHEEL_KEYS))
+        if missing or unknown:
+            raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY} of wheel {name!r}: "
+                                             f"missing {missing}, unknown {unknown}")
+        try:
+            out[name] = Wheel(name=name, **values)
+        except ValueError as exc:
+            raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY}: {exc}") from None
+    return out
+
+
 def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCurve]]:
-    """``(header, curves)`` of WPM CSV text; ``header`` maps the comment keys to values."""
+    """``(header, curves)`` of WPM CSV text; ``header`` maps the comment keys to values.
+    The ``wheel_geometry`` header, when there, must give every curve's wheel."""
     header: dict[str, str] = {}
+    lines: dict[str, int] = {}
     curves: list[WpmCurve] = []
     seen: dict[tuple, int] = {}
     columns_line, columns = 0, COLUMNS
@@ -105,6 +136,7 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
                 if not sep:
                     raise problem("header comment must read '# key: value'")
                 header[key.strip()] = value.strip()
+                lines[key.strip()] = number
                 if len(header) == 1 and key.strip() != "format":
                     raise problem(f"first line must be '# format: {FORMAT}'")
                 continue
@@ -129,6 +161,11 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
                              f"empty file: no '# format: {FORMAT}' line")
     if not curves:
         raise WpmFormatError(path, columns_line, "no curve rows after the column header")
+    wheels = wheel_geometry(header, path, lines.get(WHEEL_GEOMETRY_KEY, 0))
+    lacking = sorted({c.wheel for c in curves} - set(wheels))
+    if wheels and lacking:
+        raise WpmFormatError(path, lines[WHEEL_GEOMETRY_KEY],
+                             f"{WHEEL_GEOMETRY_KEY} lacks wheel(s) {lacking} of the curves")
     return header, curves
 
 

@@ -15,7 +15,8 @@ from fitting.errors import OutsideSlipRangeWarning
 from fitting.load_interp import InterpolatedCurve, LoadCurves, interpolate_loads
 from fitting.polynomial import curve_value
 from wpm_export.inverse import SlipSolution, solve_slip
-from wpm_export.reader import WpmCurve, read_wpm_csv
+from swtlab.domain import Wheel
+from wpm_export.reader import WpmCurve, read_wpm_csv, wheel_geometry
 from wpm_export.schema import UNITS, WpmSelectionError
 
 CurveSet = tuple[str, str, int]  # (soil, wheel, multipass)
@@ -33,6 +34,7 @@ class WheelPerformanceModule:
     def __init__(self, curves: Iterable[WpmCurve], header: dict[str, str] | None = None,
                  source: str = "<curves>", load_method: str = "auto") -> None:
         self.header, self.source, self.load_method = dict(header or {}), source, load_method
+        self.wheels: dict[str, Wheel] = wheel_geometry(self.header, source)
         self._sets: dict[CurveSet, dict[str, dict[float, WpmCurve]]] = {}
         for c in curves:
             by_quantity = self._sets.setdefault((c.soil, c.wheel, c.multipass), {})
@@ -46,6 +48,24 @@ class WheelPerformanceModule:
 
     def sets(self) -> list[CurveSet]:
         return sorted(self._sets)
+
+    def wheel(self, name: str | None = None, needed_for: str = "this") -> Wheel:
+        """The geometry of wheel ``name`` (needed only when the curves hold several wheels);
+        a one-line error when the file does not carry it (written before the
+        ``wheel_geometry`` header, or by a tool that does not write it)."""
+        names = sorted({w for _, w, _ in self._sets})
+        if name is None:
+            if len(names) != 1:
+                raise WpmSelectionError(f"{self.source}: several wheels {names}; name one")
+            name = names[0]
+        if name not in names:
+            raise WpmSelectionError(f"{self.source}: no curves of wheel {name!r}; wheels: {names}")
+        if name not in self.wheels:
+            raise WpmSelectionError(
+                f"{self.source}: no wheel geometry (header '# wheel_geometry:'), and {needed_for} "
+                f"needs wheel {name!r}'s radius, width and grousers; export the WPM CSV again "
+                "with this swtlab, or add the header (docs/wpm-csv.md)")
+        return self.wheels[name]
 
     def select(self, soil: str | None = None, wheel: str | None = None,
                multipass: int | None = None) -> CurveSet:
