@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 import terramechanics as tm
+from sim_gap.points_csv import WHEEL_KEY
 from sim_gap.vocabulary import QUANTITIES
 from wpm_export import WheelPerformanceModule
 
@@ -23,11 +24,14 @@ from wpm_export import WheelPerformanceModule
 @dataclass
 class Simulated:
     """``model``: the built-in model (the simulation itself for a TOML; the reference model
-    that computes corrections for a WPM CSV); ``wpm``: the simulator's curves, if any."""
+    that computes corrections for a WPM CSV); ``wpm``: the simulator's curves, if any;
+    ``wheel_per_row``: each point is simulated with its own source's wheel (the points'
+    wheel columns replace the model's wheel; several measured sources, docs/gap-report.md)."""
 
     model: tm.WheelModel
     wpm: WheelPerformanceModule | None = None
     source: str = "<model>"
+    wheel_per_row: bool = False
     _base_cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -46,6 +50,19 @@ class Simulated:
         return [name for name in tm.EFFECTS if name not in on]
 
     def _model_curves(self, model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
+        if not self.wheel_per_row:
+            return self._curves_at(model, points)
+        out = {q: np.full(len(points), np.nan) for q in QUANTITIES}
+        for key, idx in points.groupby(list(WHEEL_KEY), sort=False).indices.items():
+            wheel = dict(zip(("radius_m", "width_m", "grouser_count", "grouser_height_m"), key))
+            wheel["grouser_count"] = int(wheel["grouser_count"])
+            part = self._curves_at(model.with_wheel(**wheel), points.iloc[idx])
+            for q in QUANTITIES:
+                out[q][idx] = part[q]
+        return out
+
+    @staticmethod
+    def _curves_at(model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
         c = model.curves(points["wheel_load_n"].to_numpy(float), points["slip"].to_numpy(float),
                          points["multipass"].to_numpy(float),
                          points["gravity_mps2"].to_numpy(float))
