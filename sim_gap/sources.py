@@ -27,11 +27,13 @@ def describe_sources(points: pd.DataFrame, sim: Simulated, effects: list[str]) -
     """``sources``: per source its wheel, point count and condition levels; ``effects``:
     per tested effect the sources whose prediction it changes (by the untestable
     threshold of :func:`sim_gap.diagnose.testable`) and a sentence saying so."""
-    names = list(dict.fromkeys(points["source"]))
+    source = (points["source"] if "source" in points
+              else pd.Series(points.attrs.get("source", "measured"), index=points.index))
+    names = list(dict.fromkeys(source))
     wheels = points.attrs.get("wheels", {})
     sources, seen_on = [], {e: [] for e in effects}
     for name in names:
-        mask = (points["source"] == name).to_numpy()
+        mask = (source == name).to_numpy()
         rows = points[mask]
         wheel = wheels.get(name)
         sources.append({
@@ -40,7 +42,7 @@ def describe_sources(points: pd.DataFrame, sim: Simulated, effects: list[str]) -
             "loads_n": sorted(float(v) for v in rows["load_set_n"].unique()),
             "multipass": sorted(int(v) for v in rows["multipass"].unique()),
             "gravity_mps2": sorted(float(v) for v in rows["gravity_mps2"].unique())})
-        shown, _ = testable(sim, _subset(points, mask), effects)
+        shown = effects if len(names) == 1 else testable(sim, _subset(points, mask), effects)[0]
         for effect in shown:
             seen_on[effect].append(name)
     return {"sources": sources,

@@ -90,7 +90,8 @@ def diagnose_gap(measured, simulation, *, effects: list[str] | None = None,
     ``terramechanics.WheelModel`` or a simulator's WPM CSV (with ``reference_model``
     computing the effect corrections). The measured wheel must be the simulated one (radius,
     width, grousers), else ``sim_gap.wheel_check.WheelMismatchError``, unless
-    ``allow_wheel_mismatch``; sources of several wheels are each simulated with their own. ``n_boot`` bootstrap replicates, ``jobs`` worker processes.
+    ``allow_wheel_mismatch``; sources of several wheels are each simulated with their own.
+    ``n_boot`` bootstrap replicates, ``jobs`` worker processes.
     """
     from sim_gap.api import gap_report
     from sim_gap.diagnose import Settings
