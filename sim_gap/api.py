@@ -25,7 +25,8 @@ def gap_report(points: pd.DataFrame, simulated: Simulated, measured_label: str,
     """The report dict of measured ``points`` against ``simulated``, after checking that they
     are one wheel (``allow_wheel_mismatch`` goes on and records the differences). With
     sources of several wheels, each source's rows are simulated with its own wheel (the
-    model gives soil and laws; a WPM-CSV simulation, one wheel's curves, cannot)."""
+    model gives soil and laws; a WPM-CSV simulation, one wheel's curves, cannot; a points-CSV
+    simulation is read at each point's own wheel and condition)."""
     settings = settings or Settings()
     if several_wheels(points):
         if simulated.wpm is not None:
@@ -33,6 +34,8 @@ def gap_report(points: pd.DataFrame, simulated: Simulated, measured_label: str,
                              f"measured sources have {len(points.attrs['wheels'])} wheels; "
                              "simulate them with a model TOML")
         simulated, mismatches = replace(simulated, wheel_per_row=True), []
+    elif simulated.table is not None:  # each point is looked up at its own wheel
+        mismatches = []
     else:
         mismatches = check_wheels(points, simulated, allow_wheel_mismatch)
     diagnosis = diagnose(points, simulated, effects, settings)

@@ -182,3 +182,52 @@ def test_six_points_and_three_soil_parameters_are_inconclusive_not_none():
     # the held-out ranking alone would have called "no missing effect"
     losses = {c["label"]: np.array(c["held_out_run_losses"]) for c in report["candidates"]}
     assert decide(report["candidates"], losses)["verdict"] == []
+
+
+def _model_table(tmp_path, slips) -> Path:
+    """A points CSV 'simulation' of both Ding wheels written from the Ding model itself."""
+    model = tm.load_model(DING_MODEL)
+    rows = []
+    for name, count, height in (("smooth", 0, 0.0), ("lug10", 30, 0.01)):
+        c = model.with_wheel(grouser_count=count, grouser_height_m=height).curves(80.0, slips)
+        rows += [f"sim_{name},0.15735,0.165,{count},{height},80,{s},{float(d)!r},0,{float(z)!r},0\n"
+                 for s, d, z in zip(slips, c["dp_n"], c["sinkage_m"])]
+    path = tmp_path / "sim.csv"
+    path.write_text("source,wheel_radius_m,wheel_width_m,grouser_count,grouser_height_m,"
+                    "load_set_n,slip,dp_n,dp_n_se,sinkage_m,sinkage_m_se\n" + "".join(rows))
+    return path
+
+
+def test_tabulated_simulation_is_interpolated_in_slip_and_corrected_by_the_model(tmp_path):
+    from sim_gap.simulated import load_simulated
+
+    sim = load_simulated(_model_table(tmp_path, np.linspace(0.0, 0.6, 7)), DING_MODEL)
+    points = load_measured(str(DING_POINTS))
+    model = tm.load_model(DING_MODEL)
+    lug = (points["source"] == "ding2011_lug10").to_numpy()
+    direct = model.with_wheel(grouser_count=30, grouser_height_m=0.01).curves(
+        80.0, points["slip"][lug].to_numpy())
+    np.testing.assert_allclose(sim.predict(points)["dp_n"][lug], direct["dp_n"], rtol=1e-12)
+    # an effect is the model's correction on top: here the table is the model, so the
+    # corrected table is the model with the effect, at the tabulated slips
+    values = {"effects.slip_sinkage.n1": 0.4}
+    np.testing.assert_allclose(
+        sim.predict(points, values)["sinkage_m"][lug],
+        model.with_parameters(values).with_wheel(grouser_count=30, grouser_height_m=0.01
+                                                 ).curves(80.0, points["slip"][lug])["sinkage_m"],
+        rtol=1e-9)
+    # between two tabulated slips: the straight line between them (hand interpolation)
+    coarse = load_simulated(_model_table(tmp_path, np.array([0.0, 0.2, 0.4, 0.6])), DING_MODEL)
+    at = model.with_wheel(grouser_count=30, grouser_height_m=0.01).curves(80.0, [0.2, 0.4])
+    got = coarse.predict(points)["dp_n"][lug][points["slip"][lug].to_numpy() == 0.3]
+    np.testing.assert_allclose(got, 0.5 * (at["dp_n"][0] + at["dp_n"][1]), rtol=1e-12)
+
+
+def test_tabulated_simulation_is_not_extrapolated(tmp_path):
+    from sim_gap.simulated import load_simulated
+
+    sim = load_simulated(_model_table(tmp_path, np.linspace(0.0, 0.4, 5)), DING_MODEL)
+    with pytest.raises(ValueError, match=r"measured slip 0.6 is outside the simulated slips "
+                                         r"\[0, 0.4\] at \(wheel_radius_m 0.15735.*not "
+                                         "extrapolated"):
+        sim.predict(load_measured(str(DING_POINTS)))
