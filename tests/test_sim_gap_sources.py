@@ -142,6 +142,9 @@ def test_ding_smooth_and_lug_wheel_on_one_soil(tmp_path):
     assert d["chosen"] == "slip_sinkage"
     lo, hi = d["shrink"]["per_quantity"]["dp_n"]["shrink_pct_ci95"]
     assert lo < 0 < hi  # the DP shrink is not distinguishable from none
+    gap.write(html_path=tmp_path / "gap.html")
+    assert ("only ding2011_lug10 has grousers; its effect is tested on ding2011_lug10"
+            in (tmp_path / "gap.html").read_text())
 
 
 BASE = tm.shipped_model("bb2_sand").with_effects(**{n: False for n in tm.EFFECTS})
@@ -190,8 +193,8 @@ def _model_table(tmp_path, slips) -> Path:
     rows = []
     for name, count, height in (("smooth", 0, 0.0), ("lug10", 30, 0.01)):
         c = model.with_wheel(grouser_count=count, grouser_height_m=height).curves(80.0, slips)
-        rows += [f"sim_{name},0.15735,0.165,{count},{height},80,{s},{float(d)!r},0,{float(z)!r},0\n"
-                 for s, d, z in zip(slips, c["dp_n"], c["sinkage_m"])]
+        rows += [f"sim_{name},0.15735,0.165,{count},{height},80,{s},{float(d)!r},0,"
+                 f"{float(z)!r},0\n" for s, d, z in zip(slips, c["dp_n"], c["sinkage_m"])]
     path = tmp_path / "sim.csv"
     path.write_text("source,wheel_radius_m,wheel_width_m,grouser_count,grouser_height_m,"
                     "load_set_n,slip,dp_n,dp_n_se,sinkage_m,sinkage_m_se\n" + "".join(rows))
