@@ -71,12 +71,13 @@ _LIMITS = {"wheel_radius_m": (0.0, True, False), "wheel_width_m": (0.0, True, Fa
            "slip": (-1.0, False, False)}
 
 
-def read_points_csv(path: str | Path) -> pd.DataFrame:
+def read_points_csv(path: str | Path, uncertainty: bool = True) -> pd.DataFrame:
     """The rows of a points CSV as a table: ``run_id``, ``source``, ``wheel_name``, the
     wheel columns, ``load_set_n``, ``wheel_load_n``, ``multipass``, ``gravity_mps2``,
     ``slip`` and ``<q>``, ``<q>_se`` for each quantity given. A spread becomes an SE
-    (``sd / sqrt(n_repeats)``, the sd itself without ``n_repeats``). Raises
-    :class:`PointsFormatError`."""
+    (``sd / sqrt(n_repeats)``, the sd itself without ``n_repeats``). ``uncertainty``: each
+    quantity needs its SE or spread (measured side); without, they may be left out
+    (a simulation's). Raises :class:`PointsFormatError`."""
     path = str(path)
     try:
         lines = Path(path).read_text(encoding="utf-8-sig").splitlines()
@@ -104,7 +105,7 @@ def read_points_csv(path: str | Path) -> pd.DataFrame:
                                 f"{', '.join(QUANTITIES)})")
     for q in QUANTITIES:
         have = [c for c in (f"{q}_se", f"{q}_sd") if c in header]
-        if q in header and len(have) != 1:
+        if q in header and len(have) != 1 and (uncertainty or have):
             raise PointsFormatError(f"{path}:{header_line}: column {q!r}: needs exactly one "
                                     f"of {q}_se (standard error) or {q}_sd (spread)")
         if q not in header and have:
@@ -150,6 +151,10 @@ def _row(path: str, number: int, header: list[str], raw: str, quantities: list[s
     measured = False
     for q in quantities:
         spread = f"{q}_se" if f"{q}_se" in cell else f"{q}_sd"
+        if spread not in cell:  # a simulation's quantity without uncertainty
+            row[q], row[f"{q}_se"] = (_number(cell[q], where(q)) if cell[q] else np.nan), np.nan
+            measured = measured or bool(cell[q])
+            continue
         if not cell[q]:
             if cell[spread]:
                 raise PointsFormatError(f"{where(spread)}: given without the mean {q!r}")

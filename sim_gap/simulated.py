@@ -128,7 +128,7 @@ def load_simulated(source: str | Path, reference: str | Path | None = None) -> S
         ref = tm.shipped_model("bb2_sand")
         ref = ref.with_effects(**{name: False for name in tm.EFFECTS})
     if path.exists() and is_points_csv(path):
-        table = read_points_csv(path)
+        table = read_points_csv(path, uncertainty=False)
         first = table.iloc[0]
         ref = ref.with_wheel(**{c[6:] if c.startswith("wheel_") else c: first[c]
                                 for c in WHEEL_KEY})

@@ -193,11 +193,11 @@ def _model_table(tmp_path, slips) -> Path:
     rows = []
     for name, count, height in (("smooth", 0, 0.0), ("lug10", 30, 0.01)):
         c = model.with_wheel(grouser_count=count, grouser_height_m=height).curves(80.0, slips)
-        rows += [f"sim_{name},0.15735,0.165,{count},{height},80,{s},{float(d)!r},0,"
-                 f"{float(z)!r},0\n" for s, d, z in zip(slips, c["dp_n"], c["sinkage_m"])]
-    path = tmp_path / "sim.csv"
+        rows += [f"sim_{name},0.15735,0.165,{count},{height},80,{s},{float(d)!r},"
+                 f"{float(z)!r}\n" for s, d, z in zip(slips, c["dp_n"], c["sinkage_m"])]
+    path = tmp_path / "sim.csv"  # a simulation: no uncertainty columns
     path.write_text("source,wheel_radius_m,wheel_width_m,grouser_count,grouser_height_m,"
-                    "load_set_n,slip,dp_n,dp_n_se,sinkage_m,sinkage_m_se\n" + "".join(rows))
+                    "load_set_n,slip,dp_n,sinkage_m\n" + "".join(rows))
     return path
 
 
