@@ -117,6 +117,17 @@ def _untestable_notes(report: dict) -> list[Note]:
             for effect, why in report["untestable_effects"].items()]
 
 
+def _wheel_and_source_notes(report: dict) -> list[Note]:
+    """The wheel differences allowed (``--allow-wheel-mismatch``) and, with several measured
+    sources, which source each tested effect is seen on."""
+    labels = [c["label"] for c in report["candidates"]]
+    notes = [Note(f"Wheel MISMATCH allowed: {line} (measured vs simulated).", warning=True)
+             for line in (report.get("wheel") or {}).get("mismatches", [])]
+    if len(report.get("sources") or []) > 1:
+        notes += [Note(plain(e["text"], labels)) for e in report["effect_sources"].values()]
+    return notes
+
+
 def _key(region: dict) -> tuple:
     return region["slip_band"], region["load_n"], region["multipass"], region["gravity_mps2"]
 
@@ -288,7 +299,7 @@ def gap_blocks(report: dict) -> list[Block]:
                                 warning=report["verdict"] == "inconclusive")]
     if (test := decisive_test_text(report)) is not None:
         blocks.append(Note(test))
-    blocks += _untestable_notes(report)
+    blocks += _untestable_notes(report) + _wheel_and_source_notes(report)
     return blocks + _where_blocks(report) + _which_blocks(report) + _how_far_blocks(report)
 
 

@@ -102,3 +102,13 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
                       f"({100 * gain:.0f} % of the held-out loss) and every rival of the "
                       "same size by more than "
                       f"{Z_TIE:g} SE"}
+
+
+def unless_unidentifiable(decision: dict, problem: str | None) -> dict:
+    """A confident verdict (effects or ``[]``) becomes ``inconclusive`` when the campaign
+    cannot identify the chosen candidate's parameters (``problem``: the reason, from
+    :func:`sim_gap.identify.identification_problem`; None keeps the decision)."""
+    if problem is None or decision["verdict"] == "inconclusive":
+        return decision
+    return {**decision, "verdict": "inconclusive", "leaders": [], "unidentifiable": True,
+            "reason": problem}

@@ -11,9 +11,10 @@ import pandas as pd
 
 from sim_gap import candidates as cands
 from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
-from sim_gap.decide import decide, rank
+from sim_gap.decide import decide, rank, unless_unidentifiable
 from sim_gap.discriminate import separating_test
 from sim_gap.fit import quantities_of, sigmas
+from sim_gap.identify import identification_problem
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
 from sim_gap.simulated import Simulated
@@ -101,6 +102,8 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     ranked = rank(results, n)
     losses = {label: cv.run_losses(n) for label, cv in results.items()}
     decision = decide(ranked, losses)
+    decision = unless_unidentifiable(decision, identification_problem(
+        sim, results[decision["chosen"]].full, points, sig))
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
                                "out: " + ", ".join(sorted(untestable)))

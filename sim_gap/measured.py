@@ -1,12 +1,14 @@
 """The measured side: one row per run (or curve sample) with its conditions, slip and each
 quantity's mean and standard error.
 
-Columns: ``run_id``, ``load_set_n`` (set load: grouping), ``wheel_load_n`` (measured wheel
-load, used in the model), ``multipass``, ``gravity_mps2``, ``slip`` and ``<q>``, ``<q>_se``
-for the quantities of :data:`sim_gap.vocabulary.QUANTITIES` that the source has. ``attrs``:
-``source`` (text), ``wheel`` (the measured :class:`swtlab.domain.Wheel`),
-``sinkage_relative`` (True when only sinkage differences are known, e.g. a hub height
-without an absolute zero).
+Columns: ``run_id``, ``source`` (the campaign or curve set the row comes from), the wheel of
+its source (``wheel_radius_m``, ``wheel_width_m``, ``grouser_count``, ``grouser_height_m``),
+``load_set_n`` (set load: grouping), ``wheel_load_n`` (measured wheel load, used in the
+model), ``multipass``, ``gravity_mps2``, ``slip`` and ``<q>``, ``<q>_se`` for the
+quantities of :data:`sim_gap.vocabulary.QUANTITIES` that the source has. ``attrs``:
+``source`` (text), ``wheels`` (source -> its :class:`swtlab.domain.Wheel`), ``wheel`` (the
+one measured wheel, None when the sources have several), ``sinkage_relative`` (True when
+only sinkage differences are known, e.g. a hub height without an absolute zero).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import pandas as pd
 
 from fitting.polynomial import curve_value
 from fitting.table import from_run_results
+from sim_gap.points_csv import WHEEL_KEY, is_points_csv, read_points_csv, wheel_of
 from sim_gap.vocabulary import QUANTITIES
 from swtlab.domain import G0_MPS2, Wheel, check_results, wheels_of
 from wpm_export import WheelPerformanceModule
@@ -31,14 +34,54 @@ WPM_SLIP_POINTS = 9
 
 def _finish(table: pd.DataFrame, source: str, wheel: Wheel,
             sinkage_relative: bool = False) -> pd.DataFrame:
-    cols = ["run_id", "load_set_n", "wheel_load_n", "multipass", "gravity_mps2", "slip"]
+    table = table.assign(source=source, **{c: getattr(wheel, c[6:] if c.startswith("wheel_")
+                                                      else c) for c in WHEEL_KEY})
+    cols = ["run_id", "source", *WHEEL_KEY, "load_set_n", "wheel_load_n", "multipass",
+            "gravity_mps2", "slip"]
     for q in QUANTITIES:
         if q in table and table[q].notna().any():
             cols += [q, f"{q}_se"]
     out = table[cols].reset_index(drop=True)
     out["multipass"] = out["multipass"].astype(int)
-    out.attrs.update(source=source, wheel=wheel, sinkage_relative=sinkage_relative)
+    out.attrs.update(source=source, wheel=wheel, wheels={source: wheel},
+                     sinkage_relative=sinkage_relative)
     return out
+
+
+def combine(parts: list[pd.DataFrame]) -> pd.DataFrame:
+    """Measured points of several sources (e.g. a smooth and a grousered wheel on the same
+    prepared soil, or multipass and gravity series stored apart) as one table: the rows keep
+    their source and its wheel; ``attrs['wheel']`` is the common wheel, None when the
+    sources' wheels differ (docs/gap-report.md, "Several sources")."""
+    if len(parts) == 1:
+        return parts[0]
+    wheels: dict[str, Wheel] = {}
+    for part in parts:
+        for name, wheel in part.attrs["wheels"].items():
+            if name in wheels:
+                raise ValueError(f"measured source {name!r} given twice; each source once")
+            wheels[name] = wheel
+    if any(part.attrs.get("sinkage_relative") for part in parts):
+        relative = [p.attrs["source"] for p in parts if p.attrs.get("sinkage_relative")]
+        raise ValueError(f"{', '.join(relative)}: a relative sinkage (unknown zero) cannot be "
+                         "combined with other sources; diagnose it alone")
+    out = pd.concat(parts, ignore_index=True)
+    if out["run_id"].duplicated().any():
+        out["run_id"] = out["source"].astype(str) + ":" + out["run_id"].astype(str)
+    first = next(iter(wheels.values()))
+    common = all(not w.mismatches(first) for w in wheels.values())
+    out.attrs.update(source=" + ".join(p.attrs["source"] for p in parts),
+                     wheel=first if common else None, wheels=wheels, sinkage_relative=False)
+    return out
+
+
+def from_points_csv(path: str | Path) -> pd.DataFrame:
+    """The measured points of a points CSV (docs/points-csv.md), each of its sources with
+    its own wheel."""
+    table = read_points_csv(path)
+    parts = [_finish(rows, str(name), wheel_of(rows.iloc[0]))
+             for name, rows in table.groupby("source", sort=False)]
+    return combine(parts)
 
 
 def _one_wheel(wheels: dict[str, Wheel], source: str) -> Wheel:
@@ -129,7 +172,8 @@ def from_cmu_smooth_runs(path: str | Path) -> pd.DataFrame:
 
 
 def load_measured(source: str) -> pd.DataFrame:
-    """A database URL (``scheme://...``), a WPM CSV, or a CMU ``smooth_runs.csv``."""
+    """A database URL (``scheme://...``), a WPM CSV, a points CSV or a CMU
+    ``smooth_runs.csv``."""
     if "://" in source:
         return from_database(source)
     path = Path(source)
@@ -138,6 +182,9 @@ def load_measured(source: str) -> pd.DataFrame:
     head = path.read_text(encoding="utf-8-sig")[:2000]
     if head.startswith("# format:"):
         return from_wpm_csv(path)
+    if is_points_csv(path):
+        return from_points_csv(path)
     if "tractive_force_n" in head.splitlines()[0]:
         return from_cmu_smooth_runs(path)
-    raise ValueError(f"{source}: neither a WPM CSV nor a CMU smooth_runs.csv")
+    raise ValueError(f"{source}: neither a WPM CSV, a points CSV (docs/points-csv.md) nor a "
+                     "CMU smooth_runs.csv")

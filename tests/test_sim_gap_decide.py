@@ -64,7 +64,8 @@ def test_injected_effect_is_found(effects, expected):
 
 def test_multipass_on_one_level_is_untestable_with_the_contrast_it_needs():
     truth = BASE.with_effects(multipass={"stiffness_gain_per_pass": 0.3})
-    points = synthetic_points(truth, multipass=(0,), slips=(0.2, 0.5))
+    # 9 points: three per soil parameter, the fewest that can call "no missing effect"
+    points = synthetic_points(truth, multipass=(0,), slips=(0.2, 0.35, 0.5))
     report = diagnose(points, Simulated(BASE), ["multipass", "bulldozing"], FAST)
     assert "multipass" in report["untestable_effects"]
     assert "second multipass level" in report["untestable_effects"]["multipass"]

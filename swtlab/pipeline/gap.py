@@ -51,8 +51,13 @@ class GapReport:
 
 
 def _points(measured) -> tuple[pd.DataFrame, str]:
-    from sim_gap.measured import from_results_table, load_measured
+    from sim_gap.measured import combine, from_results_table, load_measured
 
+    if isinstance(measured, (list, tuple)):
+        if not measured:
+            raise ValueError("no measured source given")
+        parts = [_points(m) for m in measured]
+        return combine([p for p, _ in parts]), " + ".join(label for _, label in parts)
     if isinstance(measured, Campaign):
         label = "campaign " + ", ".join(measured.names)
         return from_results_table(measured.results, source=label), label
@@ -79,11 +84,14 @@ def diagnose_gap(measured, simulation, *, effects: list[str] | None = None,
     how far (docs/gap-report.md).
 
     ``measured``: a :class:`Campaign`, a results table (docs/results.md), a database URL, a
-    WPM CSV or a CMU ``smooth_runs.csv``; ``simulation``: a model TOML, a
+    WPM CSV, a points CSV (docs/points-csv.md) or a CMU ``smooth_runs.csv``, or a list of
+    them (several sources on one soil: the soil is fitted on all, each source keeps its
+    wheel; docs/gap-report.md, "Several sources"); ``simulation``: a model TOML, a
     ``terramechanics.WheelModel`` or a simulator's WPM CSV (with ``reference_model``
     computing the effect corrections). The measured wheel must be the simulated one (radius,
     width, grousers), else ``sim_gap.wheel_check.WheelMismatchError``, unless
-    ``allow_wheel_mismatch``. ``n_boot`` bootstrap replicates, ``jobs`` worker processes.
+    ``allow_wheel_mismatch``; sources of several wheels are each simulated with their own.
+    ``n_boot`` bootstrap replicates, ``jobs`` worker processes.
     """
     from sim_gap.api import gap_report
     from sim_gap.diagnose import Settings
