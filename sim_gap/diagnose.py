@@ -23,7 +23,7 @@ from sim_gap.simulated import Simulated
 TESTABLE_SIGMA = 0.2
 #: what each effect needs from a campaign to show (for the untestable list)
 CONTRAST_NEEDED = {"multipass": "a second multipass level",
-                   "reduced_gravity": "a gravity level other than standard gravity g0",
+                   "reduced_gravity": "a gravity level other than standard gravity (9.80665 m/s^2)",
                    "grousers": "a wheel with grousers (a grouser count and height in the model)",
                    "slip_sinkage": "several slips", "wheel_flexibility": "a flexible wheel",
                    "bulldozing": "measurable sinkage"}

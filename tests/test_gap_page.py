@@ -116,7 +116,7 @@ def test_gap_page_reads_as_plain_words_with_units(report, tmp_path):
     page = check_page(path.read_text(encoding="utf-8"))
     text = " ".join(page.text)
     assert "Reduced gravity: not testable with this campaign; it changes no prediction" in text
-    assert "gravity level other than the reference 9.81 m/s²" in text
+    assert "gravity level other than standard gravity (9.80665 m/s²)" in text
     # the fitted soil of the best explanation, in display units (kN, mm), 3 significant digits
     best = report["candidates"][0]["parameters"]
     assert f"k_φ (frictional modulus) = {sig3(best['soil.kphi'] / 1000)} kN/m^(n+2)" in text
