@@ -82,6 +82,7 @@ def process_file(path: Path, settings: ProcessSettings) -> ProcessedRun:
     import ingest
     from ingest.inspect_report import report
     from run_results import process_run
+    from softflow.track_run import run_image_slip
     from traceability.hashing import content_sha256
 
     path = Path(path)
@@ -99,7 +100,8 @@ def process_file(path: Path, settings: ProcessSettings) -> ProcessedRun:
                                      f"internal error ({type(error).__name__}: {error})"))
         return done
     try:
-        done.result = process_run(done.run, settings.stable, settings.rig)
+        done.result = process_run(done.run, settings.stable, settings.rig,
+                                  run_image_slip(done.run))
     except Exception as error:  # noqa: BLE001
         done.failures.append(Failure(str(path), "results",
                                      f"internal error ({type(error).__name__}: {error})"))
