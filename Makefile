@@ -41,8 +41,9 @@ demo: $(STAMP)
 	@echo "         one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv,"
 	@echo "         sim-to-real gap report in $(OUT)/gap.html"
 
+# One worker per core (pytest-xdist); a test file stays on one worker, so module fixtures run once.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --dist loadfile
 
 bench: $(STAMP)
 	$(BIN)/python -m bench

@@ -43,7 +43,8 @@ def main(quick: bool = False) -> dict:
         cohesion_pa=float(authors["cohesion_pa"]),
         friction_angle_deg=float(authors["friction_angle_deg"]),
         shear_modulus_m=float(authors["shear_modulus_m"]))
-    dp = model.curves(points["load_n"].to_numpy(float), points["slip"].to_numpy(float))["dp_n"]
+    dp = model.curves(points["wheel_load_n"].to_numpy(float),
+                      points["slip"].to_numpy(float))["dp_n"]
     authors_rmse = float(np.sqrt(np.mean((dp - points["dp_n"].to_numpy(float)) ** 2)))
     print(f"the authors' soil, not fitted: DP RMSE {authors_rmse:.2f} N over all 27 runs")
     return {**summary, "goal_ratio": GOAL_RATIO, "seconds": seconds,

@@ -1,6 +1,6 @@
 """Time of one gap diagnosis (sim_gap.diagnose) of a 100-run campaign with all six candidate
 effects under both laws of each (13 singles, 45 pairs on the one-law-at-a-time design):
-5 loads x 5 slips x multipass {0, 1} x gravity {9.81, 3.71}, measured values from the model
+5 loads x 5 slips x multipass {0, 1} x gravity {g0, Mars}, measured values from the model
 with a hidden slip-sinkage + bulldozing pair and 0.5 %-of-load noise. Goal: under 60 s on
 two cores (``jobs=2``); the CPU seconds of the fits are printed too (wall time on a shared
 machine depends on the other load)."""
@@ -16,6 +16,7 @@ import pandas as pd
 import terramechanics as tm
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.simulated import Simulated
+from swtlab.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
 
 LOADS_N = (80.0, 140.0, 200.0, 260.0, 320.0)
 SLIPS = (0.1, 0.25, 0.4, 0.55, 0.7)
@@ -32,11 +33,11 @@ def _cpu_s() -> float:
 
 def campaign(truth: tm.WheelModel, loads=LOADS_N, slips=SLIPS, seed: int = 1) -> pd.DataFrame:
     rng = np.random.default_rng(seed)
-    grid = np.meshgrid(loads, slips, (0, 1), (9.80665, 3.71), indexing="ij")
+    grid = np.meshgrid(loads, slips, (0, 1), (G0_MPS2, MARS_GRAVITY_MPS2), indexing="ij")
     load, slip, mp, g = (a.ravel() for a in grid)
     c = truth.curves(load, slip, mp, g)
     points = pd.DataFrame({"run_id": [f"r{i:03d}" for i in range(load.size)],
-                           "load_set_n": load, "load_n": load, "multipass": mp.astype(int),
+                           "load_set_n": load, "wheel_load_n": load, "multipass": mp.astype(int),
                            "gravity_mps2": g, "slip": slip})
     sd = {"dp_n": 0.005 * load, "torque_nm": 0.005 * load * truth.wheel.radius_m,
           "sinkage_m": np.full(load.size, 1e-4), "resistance_n": 0.005 * load}

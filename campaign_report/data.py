@@ -192,7 +192,9 @@ def _from_export(row, latest_ids: set[int], campaign_ids: set[int]
             degree_choice=d["degree_choice"],
             degree_scores=tuple((int(k), v) for k, v in d["degree_scores"].items()),
             weighting=d["weighting"], oscillates=d["oscillates"],
-            max_departure=d["max_departure"]))
+            max_departure=d["max_departure"],
+            step_below_zero=d.get("step_below_zero", 0.0),  # stored fits before the branch: 0
+            slope_below_zero=d.get("slope_below_zero", 0.0)))
     options = row.processing.parameters or {}
     stale = any(r.id not in latest_ids for f in mine for r in f.inputs)
     source = CurveSource(export_path=row.path, file_sha256=row.file_sha256,

@@ -13,9 +13,10 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from campaign_report.data import RunRecord, SetKey
-from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
+from campaign_report.style import CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette
 from fitting import CurveFit, ValidationResult, curves_by_load, interpolate_load
 from run_results.traces import TRACE_QUANTITIES
+from sim_gap.vocabulary import SLIP_BAND_EDGES, slip_band_labels
 from wpm_export import WheelPerformanceModule
 
 #: what an axis says for a run processed before traces were stored
@@ -200,4 +201,72 @@ def wpm_curves(wpm: WheelPerformanceModule, tested: dict[str, list[float]], soil
     fig.legend(handles=handles, loc="outside right upper", title="load")
     fig.suptitle(f"WPM curves as exported: {wheel} on {soil}, multipass {multipass}",
                  fontsize="medium")
+    return fig
+
+
+def slip_band_text(label: str) -> str:
+    """A residual-map slip band (``sim_gap.vocabulary`` label, slip as a fraction) in %."""
+    i = slip_band_labels().index(label)
+    return f"{SLIP_BAND_EDGES[i] * 100:g} to {SLIP_BAND_EDGES[i + 1] * 100:g}"
+
+
+def condition_text(region: dict, varying: set[str]) -> str:
+    """A region's conditions in words, only the factors that vary in the campaign."""
+    parts = [f"{region['load_n']:g} N"]
+    if "multipass" in varying:
+        parts.append(f"multipass {region['multipass']}")
+    if "gravity_mps2" in varying:
+        parts.append(f"{region['gravity_mps2']:.3g} m/s²")
+    return ", ".join(parts)
+
+
+def varying_factors(regions: list[dict]) -> set[str]:
+    return {k for k in ("multipass", "gravity_mps2") if len({r[k] for r in regions}) > 1}
+
+
+def gap_heatmap(regions: list[dict], tag: str = "") -> Figure:
+    """The residual map of a gap report (``sim_gap.regions.residual_map``): one panel per
+    quantity, rows = load (and multipass, gravity where they vary), columns = slip bands,
+    colour = mean residual (measured − simulated) in % of the load (torque: of load × wheel
+    radius; sinkage: of the radius), ``*`` = significant; ``tag="_soil_recalibrated"`` for
+    the map after soil-only recalibration."""
+    frame = pd.DataFrame(regions)
+    quantities = list(dict.fromkeys(frame["quantity"]))
+    bands = [b for b in slip_band_labels() if b in set(frame["slip_band"])]
+    varying = varying_factors(regions)
+    frame = frame.sort_values(["gravity_mps2", "multipass", "load_n"])
+    frame["row"] = [condition_text(r, varying) for r in frame.to_dict("records")]
+    rows = list(dict.fromkeys(frame["row"]))
+    fig = Figure(figsize=(3.1 * len(quantities) + 1.4, 0.32 * len(rows) + 2.3),
+                 layout="constrained")
+    axes = fig.subplots(1, len(quantities), squeeze=False)[0]
+    for ax, q in zip(axes, quantities):
+        grid = np.full((len(rows), len(bands)), np.nan)
+        star = np.zeros(grid.shape, bool)
+        for r in frame[frame["quantity"] == q].to_dict("records"):
+            i, j = rows.index(r["row"]), bands.index(r["slip_band"])
+            grid[i, j] = 100.0 * r[f"mean_residual_per_load{tag}"]
+            star[i, j] = r[f"significant{tag}"]
+        finite = np.abs(grid[np.isfinite(grid)])
+        lim = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
+        image = ax.imshow(grid, cmap="RdBu_r", vmin=-lim, vmax=lim, aspect="auto")
+        for i, j in zip(*np.nonzero(star)):
+            ax.text(j, i, "*", ha="center", va="center", fontsize=12,
+                    color="white" if abs(grid[i, j]) > 0.6 * lim else "black")
+        ax.set_xticks(range(len(bands)), [slip_band_text(b) for b in bands], rotation=40,
+                      ha="right", fontsize=8)
+        ax.set_yticks(range(len(rows)), rows if ax is axes[0] else [""] * len(rows),
+                      fontsize=8)
+        ax.set_xlabel("slip band [%]", fontsize=9)
+        ax.set_title(QUANTITIES[q].label.capitalize(), fontsize=10)
+        bar = fig.colorbar(image, ax=ax, shrink=0.9)
+        bar.set_label(f"measured − simulated [% of {PER_LOAD_OF[q]}]", fontsize=8)
+        bar.ax.tick_params(labelsize=7)
+    axes[0].set_ylabel(", ".join(["load"] + [{"multipass": "multipass",
+                                              "gravity_mps2": "gravity"}[k]
+                                             for k in sorted(varying, reverse=True)]),
+                       fontsize=9)
+    fig.suptitle(("After soil recalibration" if tag else "Simulation as given")
+                 + ": mean residual per region (* significant, Benjamini-Hochberg 5 %; "
+                   "W load, r wheel radius)", fontsize=9)
     return fig

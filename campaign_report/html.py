@@ -18,7 +18,7 @@ h1{font-size:1.6em;margin:.2em 0}h2{font-size:1.25em;margin:1.6em 0 .5em;
 dl.meta{display:grid;grid-template-columns:max-content 1fr;gap:2px 14px;margin:.6em 0}
 dl.meta dt{color:#555}dl.meta dd{margin:0}
 nav{margin:.6em 0 1em}nav a{margin-right:1em}
-table{border-collapse:collapse;font-size:13px;width:100%}
+table{border-collapse:collapse;font-size:13px;width:100%}table+table{margin-top:1em}
 th,td{border-bottom:1px solid #e3e3e3;padding:3px 6px;text-align:left;vertical-align:top}
 th{background:#f3f5f8;position:sticky;top:0}td.num{text-align:right;white-space:nowrap}
 tr.flagged td{background:#fff6df}tr.no_stable_phase td{background:#fde8e8}

@@ -67,13 +67,21 @@ def build_page(data: CampaignData, progress: Progress = _no_progress) -> Page:
 def render_report(data: CampaignData, path: str | Path,
                   progress: Progress = _no_progress) -> Path:
     """Write the page of ``data`` to ``path`` (atomically: a reader never sees half a page)."""
-    text = render_page(build_page(data, progress))
+    return write_text_atomically(render_page(build_page(data, progress)), path)
+
+
+def write_text_atomically(text: str, path: str | Path) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder, so a
+    reader never sees half a page."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as stream:
             stream.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)  # as an ordinary file, not mkstemp's 0600
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)

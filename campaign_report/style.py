@@ -1,5 +1,6 @@
 """One look for every figure of a page: a fixed colour per load, a line style and marker per
-multipass, and each plotted quantity's label, unit and display scale."""
+multipass, and the plain name, unit and display scale of each quantity, fitted parameter
+and effect that a page shows (the code names stay in the JSON and the database)."""
 
 from __future__ import annotations
 
@@ -39,6 +40,46 @@ QUANTITIES = {
 }
 #: quantities of the performance-curve figures, in panel order
 CURVE_QUANTITIES = ("dp_n", "torque_nm", "sinkage_m", "resistance_n")
+#: what a residual over load is relative to, per quantity (sim_gap.regions normalisation)
+PER_LOAD_OF = {"dp_n": "W", "torque_nm": "W·r", "sinkage_m": "r", "resistance_n": "W"}
+
+#: fitted model parameters under their dotted model names (docs/model-file.md): symbol and
+#: plain name, display unit ("-": dimensionless) and the factor from SI
+PARAMETERS = {
+    "soil.kphi": Quantity("k_φ (frictional modulus)", "kN/m^(n+2)", 1e-3),
+    "soil.friction_angle_deg": Quantity("φ (friction angle)", "°"),
+    "soil.shear_modulus_m": Quantity("K (shear deformation modulus)", "mm", 1000.0),
+    "effects.grousers.shear_radius_factor": Quantity("λ (grouser shear-radius factor)", "-"),
+    "effects.slip_sinkage.n1": Quantity("n₁ (sinkage exponent gain per unit slip)", "-"),
+    "effects.reduced_gravity.bearing_exponent": Quantity("α (k_φ ∝ g^α)", "-"),
+    "effects.wheel_flexibility.radial_stiffness_n_m": Quantity("radial wheel stiffness",
+                                                              "kN/m", 1e-3),
+    "effects.wheel_flexibility.hysteresis_coefficient": Quantity(
+        "μ_h (hysteresis resistance / load)", "-"),
+    "effects.multipass.stiffness_gain_per_pass": Quantity("soil stiffness gain per pass", "-"),
+    "effects.bulldozing.coefficient": Quantity("bulldozing factor (1 = the law as published)",
+                                               "-"),
+    "effects.grousers.lug_sinkage_gain": Quantity("κ (lug-induced sinkage gain)", "-"),
+    "effects.slip_sinkage.coefficient": Quantity("κ (exponent on Lyasko's slip-sinkage factor)",
+                                                 "-"),
+    "effects.wheel_flexibility.ground_pressure_pa": Quantity("p_g (wheel ground pressure)", "kPa",
+                                                             1e-3),
+    "effects.multipass.elastic_stiffness_pa_m": Quantity("K_e (rut reloading stiffness)",
+                                                         "MPa/m", 1e-6),
+}
+#: the effects of the built-in model (terramechanics.EFFECTS) in plain words
+EFFECTS = {"grousers": "grousers", "slip_sinkage": "slip sinkage",
+           "reduced_gravity": "reduced gravity", "wheel_flexibility": "wheel flexibility",
+           "multipass": "multipass", "bulldozing": "bulldozing"}
+
+
+def value_text(quantity: Quantity, si_value: float, digits: int = 3) -> str:
+    """``si_value`` in the display unit, with the unit (none when dimensionless)."""
+    value = float(f"{si_value * quantity.scale:.{digits}g}")
+    number = f"{value:g}" if 1e-3 <= abs(value) < 1e6 else f"{value:.{digits}g}"
+    if quantity.unit == "-":
+        return number
+    return f"{number}{'' if quantity.unit in ('°', '%') else ' '}{quantity.unit}"
 
 
 class Palette:

@@ -1,5 +1,6 @@
 """Performance-curve fits: weighted least-squares polynomials in slip per (wheel, soil,
-multipass, load) and quantity, degree 3-7 set or chosen, with diagnostics; the curve at any
+multipass, load) and quantity, degree 3-7 set or chosen, with a braked branch (step and
+slope below zero slip) where the data call for one, with diagnostics; the curve at any
 load by interpolation across the tested loads; the 120 N-style validation of it.
 
 Method after RUAG's Wheel Parametric Analytical Tool (WPAT) and Wheel Performance Module

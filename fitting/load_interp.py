@@ -4,7 +4,11 @@ RUAG WPAT: "an interpolation for various wheel loads is also implemented allowin
 the test campaign to the minimum, nominal and maximum load case only". Done on curve values,
 never on raw high-order coefficients: each tested curve is evaluated on a common slip grid
 (Chebyshev-Lobatto points on the slip range the loads share), the values are interpolated
-across load at each slip, and a polynomial is fitted to the interpolated values.
+across load at each slip, and a polynomial is fitted to the interpolated values -- plus the
+braked branch (``[slip < 0] (J + K slip)``, docs/fitting.md) with as many terms as the tested
+curve that has most, where the shared slip range reaches below zero: the values on each side
+carry their curve's branch, so the step and the slope change are interpolated across load
+with the values and fitted back as coefficients.
 
 Across load: ``"pchip"`` (monotone piecewise-cubic Hermite, Fritsch & Carlson 1980) with 3
 or more tested loads, ``"linear"`` otherwise (``"auto"`` picks so). Outside the tested loads
@@ -20,12 +24,11 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from numpy.polynomial import chebyshev
 from scipy.interpolate import PchipInterpolator
 
 from fitting.curve import DEGREES, PowerCurve
 from fitting.errors import DegreeError, LoadExtrapolationWarning, LoadRangeError
-from fitting.polynomial import horner, lobatto_grid, power_matrix, scaled_slip
+from fitting.polynomial import branch_design, branch_from_solution, curve_value, lobatto_grid
 
 GRID_POINTS = 101
 METHODS = ("auto", "linear", "pchip")
@@ -49,11 +52,12 @@ class InterpolatedCurve(PowerCurve):
 
 @dataclass(frozen=True)
 class LoadCurves:
-    """Curves at many loads at once: row ``i`` of ``coefficients`` is the curve at
-    ``loads_n[i]``; all share [slip_min, slip_max]."""
+    """Curves at many loads at once: row ``i`` of ``coefficients`` and of ``below_zero``
+    (braked branch J, K) are the curve at ``loads_n[i]``; all share [slip_min, slip_max]."""
 
     loads_n: np.ndarray
     coefficients: np.ndarray
+    below_zero: np.ndarray
     slip_min: float
     slip_max: float
     method: str
@@ -64,7 +68,9 @@ class LoadCurves:
     def curve(self, i: int) -> InterpolatedCurve:
         return InterpolatedCurve(
             coefficients=tuple(float(a) for a in self.coefficients[i]), slip_min=self.slip_min,
-            slip_max=self.slip_max, load_n=float(self.loads_n[i]), method=self.method,
+            slip_max=self.slip_max, step_below_zero=float(self.below_zero[i, 0]),
+            slope_below_zero=float(self.below_zero[i, 1]), load_n=float(self.loads_n[i]),
+            method=self.method,
             tested_loads_n=self.tested_loads_n, extrapolated=bool(self.extrapolated[i]),
             fit_rmse=float(self.fit_rmse[i]))
 
@@ -105,13 +111,17 @@ def _across_load(tested: np.ndarray, values: np.ndarray, query: np.ndarray,
 
 
 @functools.lru_cache(maxsize=64)
-def _projection(slip_min: float, slip_max: float, degree: int,
-                grid_points: int) -> tuple[np.ndarray, np.ndarray]:
-    """Slip grid and the matrix taking values on it to the power coefficients of their
-    least-squares polynomial (fitted in the Chebyshev basis)."""
+def _projection(slip_min: float, slip_max: float, degree: int, grid_points: int,
+                branch: int) -> tuple[np.ndarray, np.ndarray]:
+    """Slip grid and the matrix taking values on it to the least-squares solution (Chebyshev
+    coefficients, then ``branch`` braked-branch terms) of :func:`branch_design` there."""
     grid = lobatto_grid(slip_min, slip_max, grid_points)
-    design = chebyshev.chebvander(scaled_slip(grid, slip_min, slip_max), degree)
-    return grid, np.linalg.pinv(design).T @ power_matrix(slip_min, slip_max, degree).T
+    return grid, np.linalg.pinv(branch_design(grid, slip_min, slip_max, degree, branch)).T
+
+
+def branch_terms(curve: PowerCurve) -> int:
+    """Braked-branch terms a curve uses: 2 with a slope, 1 with a step only, else 0."""
+    return 2 if curve.slope_below_zero else 1 if curve.step_below_zero else 0
 
 
 def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: str = "auto",
@@ -134,12 +144,15 @@ def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: st
     if degree not in DEGREES:
         raise DegreeError(f"degree {degree!r} outside 3-7")
     method = ("pchip" if tested.size >= 3 else "linear") if method == "auto" else method
-    grid, projection = _projection(lo, hi, degree, grid_points)
-    values = _across_load(tested, np.array([horner(c.coefficients, grid) for c in ordered]),
+    branch = max(branch_terms(c) for c in ordered) if lo < 0 else 0
+    grid, projection = _projection(lo, hi, degree, grid_points, branch)
+    values = _across_load(tested, np.array([curve_value(c.coefficients, grid, c.step_below_zero,
+                                                        c.slope_below_zero) for c in ordered]),
                           query, method, outside)
-    coefficients = values @ projection
-    misfit = horner(coefficients[:, None, :], grid) - values
-    return LoadCurves(loads_n=query, coefficients=coefficients, slip_min=lo, slip_max=hi,
+    coefficients, below = branch_from_solution(values @ projection, lo, hi, degree)
+    misfit = curve_value(coefficients[:, None, :], grid, below[:, :1], below[:, 1:]) - values
+    return LoadCurves(loads_n=query, coefficients=coefficients, below_zero=below,
+                      slip_min=lo, slip_max=hi,
                       method=method, tested_loads_n=tuple(tested.tolist()), extrapolated=outside,
                       fit_rmse=np.sqrt(np.mean(misfit ** 2, axis=1)))
 

@@ -56,10 +56,12 @@ def quantities_in(table: pd.DataFrame) -> list[str]:
 
 def fit_results(table: pd.DataFrame, degree: int | str = "loo",
                 quantities: Iterable[str] | None = None,
-                too_few: list[TooFewPointsError] | None = None) -> list[CurveFit]:
+                too_few: list[TooFewPointsError] | None = None,
+                branch: int | str = "auto") -> list[CurveFit]:
     """One :class:`CurveFit` per (wheel, soil, multipass, load_n) group and quantity, sorted by
     group then quantity. Rows whose value (or slip) is NaN are left out of that quantity's fit.
-    ``degree``: 3-7, ``"loo"`` or ``"aicc"``. Raises :class:`FittingError` subclasses naming
+    ``degree``: 3-7, ``"loo"`` or ``"aicc"``; ``branch``: braked-branch terms, ``"auto"``
+    or 0-2 (:func:`fitting.fit.fit_curve`). Raises :class:`FittingError` subclasses naming
     the group and quantity (missing column, too few points, bad degree); with a ``too_few``
     list, a group with too few points for the degree is appended there and left out instead
     (e.g. a validation series that is not fitted itself)."""
@@ -82,7 +84,8 @@ def fit_results(table: pd.DataFrame, degree: int | str = "loo",
             try:
                 fits.append(fit_curve(rows["slip"], rows[q],
                                       rows[f"{q}_se"] if f"{q}_se" in rows else None,
-                                      degree=degree, quantity=q, wheel=str(wheel),
+                                      degree=degree, branch=branch, quantity=q,
+                                      wheel=str(wheel),
                                       soil=str(soil), multipass=int(multipass),
                                       load_n=float(load_n)))
             except TooFewPointsError as error:

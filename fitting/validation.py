@@ -50,15 +50,18 @@ class ValidationResult:
 
 def validate_load_interpolation(results_table: pd.DataFrame, validation_load_n: float = 120.0,
                                 *, degree: int | str = "loo", method: str = "auto",
-                                quantities=None) -> list[ValidationResult]:
+                                quantities=None, branch: int | str = "auto"
+                                ) -> list[ValidationResult]:
     """One :class:`ValidationResult` per (wheel, soil, multipass) with runs at
-    ``validation_load_n`` and per quantity. Raises :class:`FittingError` when no run is at
+    ``validation_load_n`` and per quantity (``degree``, ``branch``: as
+    :func:`fitting.fit.fit_curve`). Raises :class:`FittingError` when no run is at
     that load or a set has runs only there, :class:`LoadRangeError` when the other loads do
     not bracket it."""
     at_load = np.isclose(results_table["load_n"].astype(float), validation_load_n)
     if not at_load.any():
         raise FittingError(f"no runs at the validation load {validation_load_n:g} N")
-    by_set = curves_by_load(fit_results(results_table[~at_load], degree, quantities))
+    by_set = curves_by_load(fit_results(results_table[~at_load], degree, quantities,
+                                        branch=branch))
     measured = with_dp_over_w(results_table[at_load])
     out = []
     for (wheel, soil, multipass, _), rows in measured.groupby(list(KEY_COLUMNS), sort=True):

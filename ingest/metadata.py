@@ -13,8 +13,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ingest.errors import IngestError, Problem
-
-MODES = ("speed_control", "free_sled", "towed", "steered")
+from swtlab.domain import G0_MPS2, MODES, Wheel
 WRENCH_FIELDS = ("fx", "fy", "fz", "tx", "ty", "tz")
 RECORDS = ("run", "wheel", "suspension", "camera", "camera_track", "zero", "calibration")
 
@@ -40,23 +39,11 @@ class RunInfo:
     load_n: float
     slip_setpoint: float | None
     velocity_mps: float
-    gravity_mps2: float = 9.80665
+    gravity_mps2: float = G0_MPS2
     steer_deg: float | None = None
     started_at: datetime | None = None
     #: set wheel surface speed r*omega, for rigs that impose it instead of slip (channel map)
     wheel_surface_speed_setpoint_mps: float | None = None
-
-
-@dataclass(frozen=True)
-class WheelInfo:
-    """``swt.wheel``: radius without grousers; stiffness only for a flexible wheel."""
-
-    radius_m: float
-    width_m: float
-    grouser_count: int
-    grouser_height_m: float
-    stiffness_n_per_mm: float | None = None
-    mass_kg: float | None = None
 
 
 @dataclass(frozen=True)
@@ -89,7 +76,7 @@ class RunMetadata:
     """All metadata records of one run, typed and checked against each other."""
 
     run: RunInfo
-    wheel: WheelInfo
+    wheel: Wheel
     suspension: SuspensionInfo | None = None
     camera: CameraInfo | None = None
     camera_track: CameraTrackInfo | None = None
@@ -197,7 +184,7 @@ def _run_info(path: Path, values: Mapping[str, Any]) -> RunInfo:
     return RunInfo(run_id=r.text("run_id"), campaign=r.text("campaign"), wheel=r.text("wheel"),
                    soil=r.text("soil"), multipass=multipass, mode=mode, load_n=load_n,
                    slip_setpoint=slip, velocity_mps=velocity,
-                   gravity_mps2=9.80665 if gravity is None else gravity, steer_deg=steer,
+                   gravity_mps2=G0_MPS2 if gravity is None else gravity, steer_deg=steer,
                    started_at=started_at, wheel_surface_speed_setpoint_mps=surface_speed)
 
 
@@ -207,7 +194,7 @@ def _slip_from_speeds(surface_speed_mps: float, velocity_mps: float) -> float | 
     return None if denominator <= 0 else (surface_speed_mps - velocity_mps) / denominator
 
 
-def _wheel_info(path: Path, values: Mapping[str, Any]) -> WheelInfo:
+def _wheel_info(path: Path, values: Mapping[str, Any], name: str) -> Wheel:
     r = _Reader(path, "wheel", values)
     grousers = r.integer("grouser_count")
     if grousers < 0:
@@ -215,10 +202,10 @@ def _wheel_info(path: Path, values: Mapping[str, Any]) -> WheelInfo:
     height = r.number("grouser_height_m")
     if height < 0:
         raise r.fail("grouser_height_m", f"{height:g} must be >= 0")
-    return WheelInfo(radius_m=r.positive("radius_m"), width_m=r.positive("width_m"),
-                     grouser_count=grousers, grouser_height_m=height,
-                     stiffness_n_per_mm=r.positive("stiffness_N_per_mm", required=False),
-                     mass_kg=r.positive("mass_kg", required=False))
+    return Wheel(radius_m=r.positive("radius_m"), width_m=r.positive("width_m"),
+                 grouser_count=grousers, grouser_height_m=height,
+                 stiffness_n_per_mm=r.positive("stiffness_N_per_mm", required=False),
+                 mass_kg=r.positive("mass_kg", required=False), name=name)
 
 
 def _camera_info(path: Path, values: Mapping[str, Any]) -> CameraInfo:
@@ -294,8 +281,9 @@ def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
     if "camera_track" in records:
         camera_track = CameraTrackInfo(
             px_per_m=_Reader(path, "camera_track", records["camera_track"]).positive("px_per_m"))
+    run = _run_info(path, records["run"])
     metadata = RunMetadata(
-        run=_run_info(path, records["run"]), wheel=_wheel_info(path, records["wheel"]),
+        run=run, wheel=_wheel_info(path, records["wheel"], run.wheel),
         suspension=suspension,
         camera=_camera_info(path, records["camera"]) if "camera" in records else None,
         camera_track=camera_track,

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swtlab.domain.gravity import G0_MPS2
+
 
 @dataclass(frozen=True)
 class Unit:
@@ -24,7 +26,7 @@ _IN = 0.0254
 UNITS: dict[str, Unit] = {
     # force
     "N": Unit("force", 1.0), "kN": Unit("force", 1e3), "mN": Unit("force", 1e-3),
-    "lbf": Unit("force", _LBF), "kgf": Unit("force", 9.80665),
+    "lbf": Unit("force", _LBF), "kgf": Unit("force", G0_MPS2),
     # torque
     "N·m": Unit("torque", 1.0), "N*m": Unit("torque", 1.0), "Nm": Unit("torque", 1.0),
     "N.m": Unit("torque", 1.0), "N m": Unit("torque", 1.0), "kN*m": Unit("torque", 1e3),

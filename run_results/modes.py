@@ -12,24 +12,34 @@ import numpy as np
 import pandas as pd
 
 from run_results.result import RunResult
+from swtlab.domain.results import COLUMNS, WHEEL_COLUMNS, check_results
 
 
 GROUP = ["wheel", "soil", "multipass", "load_set_n"]
 
 
+def results_row(r: RunResult) -> dict:
+    """One run's row of the results table (``swtlab.domain.results``, docs/results.md)."""
+    c, w = r.condition, r.window
+    row = {"campaign": c["campaign"], "run_id": r.run_id,
+           **{k: c[k] for k in ("wheel", *WHEEL_COLUMNS, "soil")},
+           "mode": r.mode, "multipass": c["multipass"], "load_set_n": c["load_n"],
+           "slip_setpoint": c["slip_setpoint"], "velocity_set_mps": c["velocity_mps"],
+           "gravity_mps2": c["gravity_mps2"], "steer_deg": c["steer_deg"], "status": r.status,
+           "flags": "; ".join(r.flags), "window_found": w.found, "window_start_s": w.start_s,
+           "window_end_s": w.end_s, "window_method": w.method, "no_window_reason": w.reason}
+    for name, q in r.quantities.items():
+        row.update({f"{name}_mean": q.mean, f"{name}_std": q.std, f"{name}_se": q.se})
+    row.update(r.oscillation)
+    return row
+
+
 def results_table(results: list[RunResult]) -> pd.DataFrame:
-    """Run results as the one-row-per-run table of ``swtlab results`` (docs/results.md
-    columns: conditions, ``status``, ``<quantity>_mean|_std|_se``), for code without a database."""
-    rows = []
-    for r in results:
-        c = r.condition
-        row = {"run_id": r.run_id, "mode": r.mode, "status": r.status, "wheel": c.get("wheel"),
-               "soil": c.get("soil"), "multipass": c.get("multipass"),
-               "load_set_n": c.get("load_n"), "slip_setpoint": c.get("slip_setpoint")}
-        for name, q in r.quantities.items():
-            row.update({f"{name}_mean": q.mean, f"{name}_std": q.std, f"{name}_se": q.se})
-        rows.append(row)
-    return pd.DataFrame.from_records(rows)
+    """Run results as the one-row-per-run table of ``swtlab results`` (docs/results.md), for
+    code without a database; checked against the schema (``swtlab.domain.check_results``)."""
+    table = pd.DataFrame.from_records([results_row(r) for r in results],
+                                      columns=None if results else list(COLUMNS))
+    return check_results(table)
 
 
 def resistance_at_zero_slip(slip: np.ndarray, resistance_n: np.ndarray,

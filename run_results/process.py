@@ -6,9 +6,10 @@ torque ``ty``, thrust ``H = T/r``, motion resistance ``R = T/r - DP`` (Wong, The
 Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correction; for
 steered runs also the side force ``fy`` and the slip angle (logged channel, else the
 set steering angle). Single-channel quantities come from the native samples, the means of
-resistance and sinkage from the channels' native means (``native``). Runs with track photos
-(``/camera/track``) also get ``image_slip``, the slip read from the grouser marks
-(``softflow.track_run``), beside the encoder slip. Every result carries its channels'
+resistance and sinkage from the channels' native means (``native``). Given the run's track
+photos as measured (``image_slip``: the slip read from the grouser marks by
+``softflow.track_run``, which the pipeline calls; this module opens no photo), the result
+also reports ``image_slip`` beside the encoder slip. Every result carries its channels'
 decimated traces of DP, torque, sinkage and slip (``run_results.traces``), so plots need not
 read the raw file again.
 """
@@ -26,9 +27,9 @@ from run_results.phase_average import phase_average
 from run_results.result import RunResult
 from run_results.stats import QuantityStats, quantity_stats
 from run_results.traces import run_traces
-from softflow.track_run import run_image_slip
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
+from swtlab.domain.results import wheel_columns
 
 FORCE_CHANNELS = ("fx_n", "fy_n", "fz_n", "tx_nm", "ty_nm", "tz_nm", "dp_n")
 #: a measured passing frequency this far from n*omega/2pi is flagged
@@ -38,7 +39,7 @@ DP_TRACE_POINTS = 500
 
 def _condition(run) -> dict:
     info = run.metadata.run
-    return {"campaign": info.campaign, "wheel": info.wheel, "soil": info.soil,
+    return {"campaign": info.campaign, **wheel_columns(run.metadata.wheel), "soil": info.soil,
             "multipass": info.multipass, "load_n": info.load_n,
             "slip_setpoint": info.slip_setpoint, "velocity_mps": info.velocity_mps,
             "steer_deg": info.steer_deg, "gravity_mps2": info.gravity_mps2}
@@ -124,9 +125,9 @@ def _flags(run, window, oscillation: dict) -> list[str]:
     return flags
 
 
-def _image_slip(run) -> tuple[dict[str, QuantityStats], list[str]]:
-    """``image_slip`` from the run's track photos (beside the encoder slip), and its flags."""
-    image = run_image_slip(run)
+def _image_slip(image) -> tuple[dict[str, QuantityStats], list[str]]:
+    """``image_slip`` from the measured track photos (beside the encoder slip), and its flags;
+    ``image``: a ``softflow.track_run.RunImageSlip`` or None."""
     if image is None:
         return {}, []
     flags = [f"image slip: {reason}" for reason in image.refusals]
@@ -137,11 +138,12 @@ def _image_slip(run) -> tuple[dict[str, QuantityStats], list[str]]:
 
 
 def process_run(run, params: StablePhaseParams | None = None,
-                rig: RigCompliance | None = None) -> RunResult:
-    """Stable window, corrected quantities with honest SE, oscillation and flags of one run
-    (and its image slip when it carries track photos)."""
+                rig: RigCompliance | None = None, image_slip=None) -> RunResult:
+    """Stable window, corrected quantities with honest SE, oscillation and flags of one run;
+    ``image_slip``, the run's track photos as measured (``softflow.track_run.run_image_slip``,
+    which the pipeline calls), is reported beside the encoder slip."""
     window = detect_stable_phase(run, params)
-    image_quantities, image_flags = _image_slip(run)
+    image_quantities, image_flags = _image_slip(image_slip)
     series, applied = _series(run, rig)
     t = run.channels["t_s"].to_numpy()
     corrections = {"tare": tare_record(run),

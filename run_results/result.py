@@ -8,8 +8,7 @@ from run_results.stats import QuantityStats
 from run_results.traces import Trace
 from stable_phase import StableWindow
 from plain_json import jsonable
-
-STATUSES = ("ok", "flagged", "no_stable_phase")
+from swtlab.domain.results import STATUSES
 
 
 @dataclass(frozen=True)

@@ -1,29 +1,51 @@
-"""From inputs to a written report: the one call the CLI and the bench make."""
+"""Measured points and a simulation -> the gap report (after the wheel check) -> files; what
+``swtlab.diagnose_gap`` (and through it ``swtlab gap``) calls."""
 
 from __future__ import annotations
 
-from dataclasses import asdict
-from pathlib import Path
+from dataclasses import asdict, replace
+
+import pandas as pd
 
 from sim_gap.diagnose import Settings, diagnose
-from sim_gap.measured import load_measured
-from sim_gap.regions import heatmap_png
-from sim_gap.report import build_report, write_html, write_json
-from sim_gap.simulated import load_simulated
+from sim_gap.report import build_report
+from sim_gap.simulated import Simulated
+from sim_gap.sources import describe_sources
+from sim_gap.wheel_check import check_wheels
 
 
-def run_gap(measured: str, sim: str, json_path: str | Path | None = None,
-            html_path: str | Path | None = None, effects: list[str] | None = None,
-            reference_model: str | None = None, settings: Settings | None = None) -> dict:
-    """Diagnose ``measured`` (database URL, WPM CSV or CMU smooth_runs.csv) against ``sim``
-    (model TOML or WPM CSV) and write the JSON and HTML reports asked for."""
+def several_wheels(points: pd.DataFrame) -> bool:
+    """The points' sources have more than one wheel (``attrs['wheel']`` is None then)."""
+    return points.attrs.get("wheel") is None and len(points.attrs.get("wheels", {})) > 1
+
+
+def gap_report(points: pd.DataFrame, simulated: Simulated, measured_label: str,
+               sim_label: str, effects: list[str] | None = None,
+               settings: Settings | None = None, allow_wheel_mismatch: bool = False) -> dict:
+    """The report dict of measured ``points`` against ``simulated``, after checking that they
+    are one wheel (``allow_wheel_mismatch`` goes on and records the differences). With
+    sources of several wheels, each source's rows are simulated with its own wheel (the
+    model gives soil and laws; a WPM-CSV simulation, one wheel's curves, cannot; a points-CSV
+    simulation is read at each point's own wheel and condition)."""
     settings = settings or Settings()
-    points = load_measured(measured)
-    simulated = load_simulated(sim, reference_model)
-    report = build_report(diagnose(points, simulated, effects, settings), measured, sim,
-                          asdict(settings))
-    if json_path:
-        write_json(report, json_path)
-    if html_path:
-        write_html(report, html_path, heatmap_png(report["regions"]))
+    if several_wheels(points):
+        if simulated.wpm is not None:
+            raise ValueError(f"{simulated.source}: a WPM-CSV simulation is one wheel's, the "
+                             f"measured sources have {len(points.attrs['wheels'])} wheels; "
+                             "simulate them with a model TOML")
+        simulated, mismatches = replace(simulated, wheel_per_row=True), []
+    elif simulated.table is not None:  # each point is looked up at its own wheel
+        mismatches = []
+    else:
+        mismatches = check_wheels(points, simulated, allow_wheel_mismatch)
+    diagnosis = diagnose(points, simulated, effects, settings)
+    report = build_report(diagnosis, measured_label, sim_label, asdict(settings))
+    measured = points.attrs.get("wheel")
+    report["wheel"] = {"measured": None if measured is None else measured.geometry(),
+                       "simulated": "each source's own wheel" if simulated.wheel_per_row
+                       else simulated.wheel.geometry(),
+                       "model_wheel": simulated.wheel.geometry(), "mismatches": mismatches}
+    tested = sorted({e for c in diagnosis["candidates"] for e in c["effects"]})
+    described = describe_sources(points, simulated, tested)
+    report["sources"], report["effect_sources"] = described["sources"], described["effects"]
     return report

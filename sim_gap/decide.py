@@ -125,3 +125,13 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
                       + (f", each of its singles by at least {Z_CONFIDENT:g} SE"
                          if len(chosen["effects"]) > 1 else "")
                       + f", and every rival of the same size by more than {Z_TIE:g} SE"}
+
+
+def unless_unidentifiable(decision: dict, problem: str | None) -> dict:
+    """A confident verdict (effects or ``[]``) becomes ``inconclusive`` when the campaign
+    cannot identify the chosen candidate's parameters (``problem``: the reason, from
+    :func:`sim_gap.identify.identification_problem`; None keeps the decision)."""
+    if problem is None or decision["verdict"] == "inconclusive":
+        return decision
+    return {**decision, "verdict": "inconclusive", "leaders": [], "unidentifiable": True,
+            "reason": problem}

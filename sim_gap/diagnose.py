@@ -12,9 +12,10 @@ import pandas as pd
 
 from sim_gap import candidates as cands
 from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
-from sim_gap.decide import rank
+from sim_gap.decide import rank, unless_unidentifiable
 from sim_gap.discriminate import separating_test
 from sim_gap.fit import quantities_of, sigmas
+from sim_gap.identify import identification_problem
 from sim_gap.laws import reference_laws, robust_decide
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
@@ -24,8 +25,8 @@ from sim_gap.simulated import Simulated
 TESTABLE_SIGMA = 0.2
 #: what each effect needs from a campaign to show (for the untestable list)
 CONTRAST_NEEDED = {"multipass": "a second multipass level",
-                   "reduced_gravity": "a gravity level other than the reference 9.81 m/s^2",
-                   "grousers": "a wheel with grousers (grouser_count, grouser_height_m > 0)",
+                   "reduced_gravity": "a gravity level other than standard gravity (9.80665 m/s^2)",
+                   "grousers": "a wheel with grousers (a grouser count and height in the model)",
                    "slip_sinkage": "several slips", "wheel_flexibility": "a flexible wheel",
                    "bulldozing": "measurable sinkage"}
 
@@ -63,7 +64,8 @@ def testable(sim: Simulated, points: pd.DataFrame, laws: dict[str, tuple[str, ..
         if change >= TESTABLE_SIGMA:
             keep.append(name)
         else:
-            dropped[name] = f"no effect at these conditions; needs {CONTRAST_NEEDED[name]}"
+            dropped[name] = (f"it changes no prediction at these conditions; the campaign "
+                             f"needs {CONTRAST_NEEDED[name]}")
     return keep, dropped
 
 
@@ -110,6 +112,8 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     results.update(_run_all(sim, pairs, points, sig, settings,
                             [_pair_start(c, results) for c in pairs]))
     decision = robust_decide(results, allowed, reference, n)
+    decision = unless_unidentifiable(decision, identification_problem(
+        sim, results[decision["chosen"]].full, points, sig))
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
                                "out: " + ", ".join(sorted(untestable)))

@@ -10,14 +10,15 @@ import pandas as pd
 from sim_gap.fit import quantities_of
 from sim_gap.simulated import Simulated
 from sim_gap.vocabulary import model_error_floor
+from swtlab.domain.gravity import MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2
 
 #: gravity levels proposed when a campaign has only one: Mars and the Moon
-PROPOSED_GRAVITY_MPS2 = (3.71, 1.62)
+PROPOSED_GRAVITY_MPS2 = (MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2)
 
 
 def _grid(loads, slips, multipass, gravity) -> pd.DataFrame:
     w, s, m, g = np.meshgrid(loads, slips, multipass, gravity, indexing="ij")
-    return pd.DataFrame({"load_set_n": w.ravel(), "load_n": w.ravel(), "slip": s.ravel(),
+    return pd.DataFrame({"load_set_n": w.ravel(), "wheel_load_n": w.ravel(), "slip": s.ravel(),
                          "multipass": m.ravel().astype(int), "gravity_mps2": g.ravel()})
 
 
@@ -60,7 +61,7 @@ def separating_test(sim: Simulated, points: pd.DataFrame, values_a: dict[str, fl
     for text, grid, change in proposals(points, wheel.grouser_count > 0
                                         and wheel.grouser_height_m > 0):
         a, b = sim.predict(grid, {**values_a, **change}), sim.predict(grid, {**values_b, **change})
-        load = grid["load_n"].to_numpy(float)
+        load = grid["wheel_load_n"].to_numpy(float)
         sep = max(float(np.nanmax(np.abs(a[q] - b[q]) / model_error_floor(q, load, sim.radius_m)))
                   for q in quantities)
         if sep > best["separation_sigma"]:

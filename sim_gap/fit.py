@@ -26,7 +26,7 @@ def quantities_of(points: pd.DataFrame) -> list[str]:
 
 def sigmas(points: pd.DataFrame, radius_m: float) -> dict[str, np.ndarray]:
     """Per-point uncertainty of each quantity for fitting: SE and the floor in quadrature."""
-    load = points["load_n"].to_numpy(float)
+    load = points["wheel_load_n"].to_numpy(float)
     return {q: np.hypot(points[f"{q}_se"].to_numpy(float), model_error_floor(q, load, radius_m))
             for q in quantities_of(points)}
 

@@ -30,7 +30,8 @@ def holdout_dp(points: pd.DataFrame, model: tm.WheelModel, edges=HOLDOUT_BAND_ED
         train.attrs.update(points.attrs)
         cal = calibrate_soil(train, model, **calibrate_kwargs)
         test = points[bands == band]
-        dp = cal.model.curves(test["load_n"].to_numpy(float), test["slip"].to_numpy(float))["dp_n"]
+        dp = cal.model.curves(test["wheel_load_n"].to_numpy(float),
+                              test["slip"].to_numpy(float))["dp_n"]
         rows.append(pd.DataFrame({"band": band, "slip": test["slip"].to_numpy(float),
                                   "dp_measured_n": test["dp_n"].to_numpy(float),
                                   "dp_predicted_n": dp, "status": cal.status}))

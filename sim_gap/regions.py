@@ -1,11 +1,9 @@
 """Where the gap lies: residuals of each quantity over slip band x load x multipass x
 gravity, normalised by load and by uncertainty; a chi-square test per region with
 Benjamini-Hochberg control of the false discovery rate (Benjamini & Hochberg 1995, JRSS B
-57:289-300); a heatmap."""
+57:289-300). Its heatmap is drawn by ``campaign_report.figures.gap_heatmap``."""
 
 from __future__ import annotations
-
-import io
 
 import numpy as np
 import pandas as pd
@@ -42,15 +40,16 @@ def _normaliser(q: str, load: np.ndarray, radius_m: float) -> np.ndarray:
 
 
 def residual_map(points: pd.DataFrame, as_given: dict[str, np.ndarray],
-                 soil_recalibrated: dict[str, np.ndarray], radius_m: float = 0.125) -> list[dict]:
+                 soil_recalibrated: dict[str, np.ndarray], radius_m: float) -> list[dict]:
     """One entry per region and quantity: mean residual (measured - simulated, SI and over
     load), its z and chi-square p-value with the uncertainty ``SE (+) repeatability floor``,
-    significance after BH, for the simulation as given and after soil-only recalibration."""
+    significance after BH, for the simulation as given and after soil-only recalibration.
+    ``radius_m``: the wheel's radius (normalises torque and sinkage)."""
     sig = sigmas(points, radius_m)
     keys = pd.DataFrame({"slip_band": np.array(slip_band_labels())[
         slip_band(points["slip"].to_numpy(float))], "load_n": points["load_set_n"].round(1),
         "multipass": points["multipass"], "gravity_mps2": points["gravity_mps2"].round(3)})
-    load = points["load_n"].to_numpy(float)
+    load = points["wheel_load_n"].to_numpy(float)
     rows = []
     for key, idx in keys.groupby(list(keys.columns), sort=True).indices.items():
         for q in quantities_of(points):
@@ -85,42 +84,3 @@ def largest_gap(regions: list[dict]) -> dict:
             "region": {k: worst[k] for k in ("slip_band", "load_n", "multipass",
                                              "gravity_mps2", "quantity")}}
 
-
-def heatmap_png(regions: list[dict], tag: str = "") -> bytes:
-    """PNG: one panel per quantity, rows = (load, multipass, gravity), columns = slip bands,
-    colour = mean residual over load, '*' = significant."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    frame = pd.DataFrame(regions)
-    quantities = list(dict.fromkeys(frame["quantity"]))
-    bands = [b for b in slip_band_labels() if b in set(frame["slip_band"])]
-    frame["row"] = frame.apply(lambda r: f"{r.load_n:g} N, mp{r.multipass}, "
-                                         f"g={r.gravity_mps2:g}", axis=1)
-    rows = list(dict.fromkeys(frame.sort_values(["gravity_mps2", "multipass", "load_n"])["row"]))
-    fig, axes = plt.subplots(1, len(quantities), figsize=(3.2 * len(quantities) + 1,
-                                                         0.45 * len(rows) + 1.8), squeeze=False)
-    for ax, q in zip(axes[0], quantities):
-        sub = frame[frame["quantity"] == q]
-        grid = np.full((len(rows), len(bands)), np.nan)
-        star = np.zeros_like(grid, bool)
-        for _, r in sub.iterrows():
-            i, j = rows.index(r["row"]), bands.index(r["slip_band"])
-            grid[i, j] = r[f"mean_residual_per_load{tag}"]
-            star[i, j] = r[f"significant{tag}"]
-        lim = np.nanmax(np.abs(grid)) or 1.0
-        im = ax.imshow(grid, cmap="RdBu_r", vmin=-lim, vmax=lim, aspect="auto")
-        for i, j in zip(*np.nonzero(star)):
-            ax.text(j, i, "*", ha="center", va="center", fontsize=12)
-        ax.set_xticks(range(len(bands)), bands, rotation=45, fontsize=7)
-        ax.set_yticks(range(len(rows)), rows if ax is axes[0][0] else [""] * len(rows),
-                      fontsize=7)
-        ax.set_title(f"{q} (measured - sim) / load", fontsize=8)
-        fig.colorbar(im, ax=ax, shrink=0.8)
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    plt.close(fig)
-    return buf.getvalue()

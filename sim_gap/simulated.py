@@ -1,8 +1,8 @@
-"""The simulated side: the built-in model from a TOML file, or a WPM CSV written by any
-simulator (DEM, FEM, SCM ...).
+"""The simulated side: the built-in model from a TOML file, or a WPM CSV or a points CSV
+(tabulated, docs/points-csv.md) written by any simulator (DEM, FEM, SCM ...).
 
-For a WPM CSV an effect (or a soil recalibration) is added as the correction the built-in
-reference model computes for it at the same conditions:
+For a WPM CSV or a points CSV an effect (or a soil recalibration) is added as the correction
+the built-in reference model computes for it at the same conditions:
 ``sim + (model(theta, effects) - model(theta_0))``. For a model TOML the prediction is the
 model itself, ``model(theta, effects)``.
 """
@@ -16,6 +16,8 @@ import numpy as np
 import pandas as pd
 
 import terramechanics as tm
+from sim_gap.points_csv import WHEEL_KEY, is_points_csv, read_points_csv
+from sim_gap.tabulated import at_points
 from sim_gap.vocabulary import QUANTITIES
 from wpm_export import WheelPerformanceModule
 
@@ -23,25 +25,53 @@ from wpm_export import WheelPerformanceModule
 @dataclass
 class Simulated:
     """``model``: the built-in model (the simulation itself for a TOML; the reference model
-    that computes corrections for a WPM CSV); ``wpm``: the simulator's curves, if any."""
+    that computes corrections for a WPM CSV); ``wpm``: the simulator's curves, if any;
+    ``table``: its tabulated points (:mod:`sim_gap.tabulated`), if any; ``wheel_per_row``:
+    each point is simulated with its own source's wheel (the points' wheel columns replace
+    the model's wheel; several measured sources, docs/gap-report.md)."""
 
     model: tm.WheelModel
     wpm: WheelPerformanceModule | None = None
     source: str = "<model>"
+    wheel_per_row: bool = False
+    table: pd.DataFrame | None = None
     _base_cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def radius_m(self) -> float:
         return self.model.wheel.radius_m
 
+    @property
+    def wheel(self):
+        """The simulated wheel (a WPM CSV's, which the reference model was given)."""
+        return self.model.wheel
+
+    @property
+    def external(self) -> bool:
+        """Another simulator's output (WPM CSV or points CSV), corrected by the model."""
+        return self.wpm is not None or self.table is not None
+
     def missing_effects(self) -> list[str]:
         """Effects of the vocabulary that the simulation does not have on (the candidates).
-        A WPM simulator is taken to have none of them."""
-        on = set() if self.wpm is not None else set(self.model.effects)
+        Another simulator is taken to have none of them."""
+        on = set() if self.external else set(self.model.effects)
         return [name for name in tm.EFFECTS if name not in on]
 
     def _model_curves(self, model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
-        c = model.curves(points["load_n"].to_numpy(float), points["slip"].to_numpy(float),
+        if not self.wheel_per_row:
+            return self._curves_at(model, points)
+        out = {q: np.full(len(points), np.nan) for q in QUANTITIES}
+        for key, idx in points.groupby(list(WHEEL_KEY), sort=False).indices.items():
+            wheel = dict(zip(("radius_m", "width_m", "grouser_count", "grouser_height_m"), key))
+            wheel["grouser_count"] = int(wheel["grouser_count"])
+            part = self._curves_at(model.with_wheel(**wheel), points.iloc[idx])
+            for q in QUANTITIES:
+                out[q][idx] = part[q]
+        return out
+
+    @staticmethod
+    def _curves_at(model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
+        c = model.curves(points["wheel_load_n"].to_numpy(float), points["slip"].to_numpy(float),
                          points["multipass"].to_numpy(float),
                          points["gravity_mps2"].to_numpy(float))
         return {q: c[q] for q in QUANTITIES}
@@ -50,7 +80,8 @@ class Simulated:
         out = {q: np.full(len(points), np.nan) for q in QUANTITIES}
         for mp, idx in points.groupby("multipass").indices.items():
             sub = points.iloc[idx]
-            values = self.wpm.at_slip(sub["slip"].to_numpy(float), sub["load_n"].to_numpy(float),
+            values = self.wpm.at_slip(sub["slip"].to_numpy(float),
+                                      sub["wheel_load_n"].to_numpy(float),
                                       multipass=int(mp), allow_extrapolation=True)
             for q, v in values.items():
                 if q in out:
@@ -58,11 +89,14 @@ class Simulated:
         return out
 
     def _base(self, points: pd.DataFrame) -> tuple[dict, dict]:
-        key = points[["load_n", "slip", "multipass", "gravity_mps2"]].to_numpy(float).tobytes()
+        cols = ["wheel_load_n", "slip", "multipass", "gravity_mps2"]
+        key = points[cols + [c for c in WHEEL_KEY if c in points]].to_numpy(float).tobytes()
         if key not in self._base_cache:
             self._base_cache.clear()
             model0 = self._model_curves(self.model, points)
-            sim0 = self._wpm_curves(points) if self.wpm is not None else model0
+            sim0 = (self._wpm_curves(points) if self.wpm is not None else
+                    at_points(self.table, points, self.source) if self.table is not None
+                    else model0)
             self._base_cache[key] = (model0, sim0)
         return self._base_cache[key]
 
@@ -71,7 +105,7 @@ class Simulated:
         """Each quantity at every point with the dotted-name ``values`` changed (naming
         ``effects.<name>.<param>`` switches that effect on)."""
         values = values or {}
-        if self.wpm is None:
+        if not self.external:
             return self._model_curves(self.model.with_parameters(values), points)
         model0, sim0 = self._base(points)
         if not values:
@@ -81,8 +115,10 @@ class Simulated:
 
 
 def load_simulated(source: str | Path, reference: str | Path | None = None) -> Simulated:
-    """A model TOML, or a WPM CSV with ``reference`` (a model TOML; default: the shipped
-    ``bb2_sand`` soil and wheel with every effect off) computing the corrections."""
+    """A model TOML, or a WPM CSV or points CSV with ``reference`` (a model TOML; default:
+    the shipped ``bb2_sand`` soil with every effect off) computing the corrections. The
+    reference model takes the WPM CSV's wheel (its geometry header is required: one wheel);
+    for a points CSV each measured point's own wheel, which must be one of the table's."""
     path = Path(source)
     if path.suffix.lower() == ".toml":
         return Simulated(tm.load_model(path), source=str(path))
@@ -91,4 +127,18 @@ def load_simulated(source: str | Path, reference: str | Path | None = None) -> S
     else:
         ref = tm.shipped_model("bb2_sand")
         ref = ref.with_effects(**{name: False for name in tm.EFFECTS})
-    return Simulated(ref, WheelPerformanceModule.load(path), source=str(path))
+    if path.exists() and is_points_csv(path):
+        table = read_points_csv(path, uncertainty=False)
+        first = table.iloc[0]
+        ref = ref.with_wheel(**{c[6:] if c.startswith("wheel_") else c: first[c]
+                                for c in WHEEL_KEY})
+        return Simulated(ref, source=str(path), wheel_per_row=True, table=table)
+    wpm = WheelPerformanceModule.load(path)
+    names = sorted({wheel for _, wheel, _ in wpm.sets()})
+    if len(names) != 1:
+        raise ValueError(f"{path}: curves of {len(names)} wheels {names}; a simulation is "
+                         "one wheel's")
+    wheel = wpm.wheel(names[0], needed_for="the gap diagnosis")
+    return Simulated(ref.with_wheel(**{k: getattr(wheel, k) for k in (
+        "name", "radius_m", "width_m", "grouser_count", "grouser_height_m")}), wpm,
+                     source=str(path))

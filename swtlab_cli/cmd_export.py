@@ -39,41 +39,30 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from traceability.provenance import swtlab_version
-
-    from fitting import FittingError, fit_results, from_run_results
+    from fitting import FittingError
+    from swtlab.pipeline.curves import export_wpm, fit_curves
     from traceability import open_database
     from traceability.queries import latest_results
     from traceability.store_fits import store_export, store_fits
-    from wpm_export import inputs_sha256, write_wpm_csv
     from wpm_export.schema import FORMAT
 
     statuses = ("ok", "flagged") if args.include_flagged else ("ok",)
-    options = {"degree": args.degree, "statuses": list(statuses)}
     session_factory = open_database(args.db)
     with session_factory.begin() as session:
-        results = latest_results(session)
-        table = from_run_results(results, statuses=statuses) if len(results) else results
-        if table.empty:
-            print(f"swtlab export: {args.db}: no usable run results (run swtlab process first)",
-                  file=sys.stderr)
-            return exit_codes.BAD_INPUT
-        too_few: list[FittingError] = []
         try:
-            fits = fit_results(table, degree=args.degree, too_few=too_few)
-        except FittingError as error:
-            print(f"swtlab export: {error}", file=sys.stderr)
+            curves = fit_curves(latest_results(session), degree=args.degree, statuses=statuses)
+        except (FittingError, ValueError) as error:
+            print(f"swtlab export: {args.db}: {error}", file=sys.stderr)
             return exit_codes.BAD_INPUT
-        stored = store_fits(session, table, fits, options)
-        inputs_hash = inputs_sha256(table)
-        file_hash = write_wpm_csv(fits, args.output, inputs_hash, swtlab_version())
-        store_export(session, args.output, file_hash, inputs_hash, FORMAT, stored, options)
-    for error in too_few:
+        stored = store_fits(session, curves.table, curves.fits, curves.options)
+        file_hash = export_wpm(curves, args.output)
+        store_export(session, args.output, file_hash, curves.inputs_sha256, FORMAT, stored,
+                     curves.options)
+    for error in curves.not_fitted:
         print(f"  not fitted: {error}")
-    flagged = [f for f in fits if f.oscillates]
-    print(f"{len(fits)} curves from {len(table)} runs written to {args.output} "
-          f"(sha256 {file_hash[:12]}, inputs {inputs_hash[:12]})")
-    for fit in flagged:
+    print(f"{len(curves.fits)} curves from {len(curves.table)} runs written to {args.output} "
+          f"(sha256 {file_hash[:12]}, inputs {curves.inputs_sha256[:12]})")
+    for fit in curves.flagged:
         print(f"  flagged: {fit.quantity} at {fit.load_n:g} N, multipass {fit.multipass}: "
               "the polynomial oscillates between its points; try a lower --degree")
     return exit_codes.OK

@@ -1,5 +1,5 @@
-"""``swtlab gap --measured DB_URL_OR_CSV --sim MODEL_TOML_OR_WPM [--json F] [--html F]``:
-the sim-to-real gap diagnosis (docs/gap-report.md)."""
+"""``swtlab gap --measured DB_URL_OR_CSV [--measured ...] --sim MODEL_TOML_OR_WPM [--json F]
+[--html F]``: the sim-to-real gap diagnosis (docs/gap-report.md)."""
 
 from __future__ import annotations
 
@@ -19,8 +19,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "would decide); held-out RMSE before and after. docs/gap-report.md. "
                     "With a database as the measured side, the report is also recorded there "
                     "(and shown by swtlab report).")
-    p.add_argument("--measured", required=True,
-                   help="database URL (swtlab process), WPM CSV, or CMU smooth_runs.csv")
+    p.add_argument("--measured", required=True, action="append",
+                   help="database URL (swtlab process), WPM CSV, points CSV "
+                        "(docs/points-csv.md) or CMU smooth_runs.csv; repeat for several "
+                        "sources on one soil (fitted jointly, each with its own wheel)")
     p.add_argument("--sim", required=True, help="model TOML or a simulator's WPM CSV")
     p.add_argument("--reference-model", help="model TOML computing effect corrections for a "
                                              "WPM-CSV simulation (default: bb2_sand, no effects)")
@@ -35,6 +37,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
     p.add_argument("--boot", type=int, default=200, help="bootstrap replicates (default 200)")
     p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
+    p.add_argument("--allow-wheel-mismatch", action="store_true",
+                   help="diagnose even when the measured wheel is not the simulated one "
+                        "(radius, width, grousers); the differences go into the report")
     p.set_defaults(func=run)
 
 
@@ -54,9 +59,8 @@ def parse_laws(text: str) -> dict[str, tuple[str, ...]]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim_gap.api import run_gap
-    from sim_gap.diagnose import Settings
     from sim_gap.vocabulary import EFFECT_NAMES
+    from swtlab.pipeline.gap import diagnose_gap
 
     effects = None
     if args.effects:
@@ -72,18 +76,27 @@ def run(args: argparse.Namespace) -> int:
         print(f"swtlab gap: --laws: {exc}", file=sys.stderr)
         return exit_codes.USAGE
     try:
-        report = run_gap(args.measured, args.sim, args.json, args.html, effects,
-                         args.reference_model,
-                         Settings(n_boot=args.boot, jobs=args.jobs, seed=args.seed, laws=laws))
+        measured = args.measured[0] if len(args.measured) == 1 else args.measured
+        gap = diagnose_gap(measured, args.sim, effects=effects,
+                           reference_model=args.reference_model, n_boot=args.boot,
+                           jobs=args.jobs, seed=args.seed, laws=laws,
+                           allow_wheel_mismatch=args.allow_wheel_mismatch)
+        gap.write(args.json, args.html)
     except (OSError, ValueError, KeyError) as exc:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
-    if "://" in args.measured:  # measured from a database: the report is recorded there too
+    report = gap.to_dict()
+    if len(args.measured) == 1 and "://" in args.measured[0]:  # recorded in the database too
         from traceability import open_database
         from traceability.store_gap import store_gap_report
 
-        with open_database(args.measured).begin() as session:
+        with open_database(args.measured[0]).begin() as session:
             store_gap_report(session, report)
+    for line in report["wheel"]["mismatches"]:
+        print(f"wheel mismatch allowed: {line}")
+    if len(report["sources"]) > 1:
+        for effect in report["effect_sources"].values():
+            print(effect["text"])
     verdict = report["verdict"]
     print("verdict:", verdict if isinstance(verdict, str) else (", ".join(verdict) or "none"))
     print("reason:", report["reason"])

@@ -15,10 +15,10 @@ import sys
 import tomllib
 from pathlib import Path
 
+from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
 from swtlab_cli.progress import progress
 
-CAMPAIGN_SETTINGS = "swtlab.toml"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -41,74 +41,23 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def _rig_compliance(args: argparse.Namespace):
-    from run_results import RigCompliance
-
-    path = args.rig_compliance or (args.campaign / CAMPAIGN_SETTINGS)
-    if not path.is_file():
-        if args.rig_compliance:
-            raise FileNotFoundError(f"{path}: no such file")
-        return None
-    table = tomllib.loads(path.read_text()).get("rig_compliance")
-    if table is None:
-        raise ValueError(f"{path}: no [rig_compliance] table")
-    return RigCompliance.from_dict(table)
-
-
-def _soil_flow(session, run_read, raw_file, window, parameters: dict) -> tuple[bool, str | None]:
-    """Measure and store the run's soil flow over its stable window: whether one was measured,
-    and why not when its frames could not be analysed."""
-    from softflow.flow_archive import pack_flow
-    from softflow.flow_run import FlowRunError, run_flow
-    from traceability.store_flow import store_flow, store_flow_failure
-
-    if not window.found:
-        return False, None
-    try:
-        flow = run_flow(run_read, window.start_s, window.end_s, parameters["flow"]["max_frames"])
-    except FlowRunError as error:
-        store_flow_failure(session, raw_file, error.channel, error.problem, parameters)
-        return False, str(error)
-    except Exception as error:  # noqa: BLE001 - one run's camera must not stop the batch
-        problem = f"internal error in the flow analysis ({type(error).__name__}: {error})"
-        store_flow_failure(session, raw_file, "/camera/side", problem, parameters)
-        return False, f"{run_read.source}: /camera/side: {problem}"
-    if flow is None:
-        return False, None
-    store_flow(session, raw_file, window, flow.result, pack_flow(flow.result, flow.first_frame),
-               parameters)
-    return True, None
-
-
 def run(args: argparse.Namespace) -> int:
     import ingest
-    from ingest.inspect_report import report
-    from run_results import process_run
-    from softflow.flow_run import MAX_FRAMES
-    from stable_phase import StablePhaseParams
-    from traceability import open_database, store_ingested_run
+    from swtlab.pipeline.database import store_processed
+    from swtlab.pipeline.process import ProcessSettings, find_runs, process_file, rig_compliance
+    from traceability import open_database
     from traceability.hashing import content_sha256
     from traceability.store_flow import stored_flow_failure
-    from traceability.store_results import (find_result, params_sha256, processed_file,
-                                            store_ingest_failure, store_run_result)
+    from traceability.store_results import params_sha256, processed_file
 
-    if not args.campaign.is_dir():
-        print(f"swtlab process: {args.campaign}: no such folder", file=sys.stderr)
-        return exit_codes.BAD_INPUT
     try:
-        rig = _rig_compliance(args)
-        paths = ingest.find_runs(args.campaign, channel_map=args.channel_map)
+        paths = find_runs(args.campaign, args.channel_map)
+        settings = ProcessSettings(channel_map=args.channel_map,
+                                   rig=rig_compliance(args.campaign, args.rig_compliance))
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
         print(f"swtlab process: {error}", file=sys.stderr)
         return exit_codes.BAD_INPUT
-    if not paths:
-        print(f"swtlab process: {args.campaign}: no runs found (MCAP files or folders with "
-              "run.json; --channel-map for other files)", file=sys.stderr)
-        return exit_codes.BAD_INPUT
-    stable_params = StablePhaseParams()
-    parameters = {"stable_phase": stable_params.to_dict(), "channel_map": args.channel_map,
-                  "rig_compliance": rig.to_dict() if rig else None,
-                  "flow": {"max_frames": MAX_FRAMES}}
+    parameters = settings.parameters()
     params_hash = params_sha256(parameters)
     session_factory = open_database(args.db)
     statuses: dict[str, list[str]] = {"ok": [], "flagged": [], "no_stable_phase": []}
@@ -124,26 +73,21 @@ def run(args: argparse.Namespace) -> int:
                 if known is not None:
                     flow_failed.append(f"{path}: {known.channel}: {known.problem}")
                 continue
-            try:
-                run_read = ingest.read_run(path, channel_map=args.channel_map)
-            except ingest.IngestError as error:
-                store_ingest_failure(session, path, sha256, str(error), parameters)
-                failed.append(str(error))
-                continue
-            raw_file, _ = store_ingested_run(session, run_read, report(run_read)["streams"],
-                                             {**parameters, "derivation": run_read.derivation})
-            if find_result(session, raw_file, params_hash) is None:
-                result = process_run(run_read, stable_params, rig)
-                stored = store_run_result(session, raw_file, result, parameters)
-                measured, problem = _soil_flow(session, run_read, raw_file, stored.window,
-                                               parameters)
-                flows += measured
-                flow_failed += [problem] if problem else []
-                reasons = "; ".join(result.flags)
-                statuses.setdefault(result.status, []).append(
-                    f"{run_read.run_id}: {reasons}" if reasons else run_read.run_id)
-            else:
-                up_to_date += 1
+            processed = process_file(path, settings)
+            stored = store_processed(session, processed, parameters)
+        failed += [f.reason for f in processed.failures if f.stage != "soil_flow"]
+        if processed.result is None:
+            continue
+        if not stored:
+            up_to_date += 1
+            continue
+        result = processed.result
+        flows += processed.flow is not None
+        flow_failed += [f"{processed.run.source}: /camera/side: {f.reason}"
+                        for f in processed.failures if f.stage == "soil_flow"]
+        reasons = "; ".join(result.flags)
+        statuses.setdefault(result.status, []).append(
+            f"{result.run_id}: {reasons}" if reasons else result.run_id)
     done = sum(len(v) for v in statuses.values())
     print(f"processed {done} of {len(paths)} runs ({up_to_date} already up to date): "
           f"{len(statuses['ok'])} ok, {len(statuses['flagged'])} flagged, "

@@ -96,6 +96,9 @@ def _print_text(answer: dict) -> None:
         q, u = answer["quantity"], answer["unit"]
         if answer["status"] == "ok":
             print(f"{q} = {answer['target']:g} {u} at slip {answer['slip']:.6g}")
+        elif answer["status"] == "at_step":
+            print(f"{q} = {answer['target']:g} {u} at slip 0: inside the curve's jump at zero "
+                  "slip (braked side to driven side)")
         elif answer["status"] == "above_max":
             print(f"{q} = {answer['target']:g} {u} is beyond the wheel: slip 1.0 (100 %), "
                   f"maximum achievable {answer['value']:.6g} {u}")

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from terramechanics import stress
+from terramechanics import slip_soil_ding2015, stress
 from terramechanics.effects import EFFECTS, LAWS, Effect, make_effect
 from terramechanics.equilibrium import solve_increasing
 from terramechanics.soil import SoilParams
@@ -163,9 +163,11 @@ class WheelModel:
         return SoilState(kc=full(s.kc), kphi=full(s.kphi), n0=full(s.n), n_slope=full(0.0),
                          cohesion_pa=full(s.cohesion_pa),
                          phi_rad=full(np.radians(s.friction_angle_deg)),
-                         shear_modulus_m=full(s.shear_modulus_m),
+                         shear_modulus_m=slip_soil_ding2015.shear_modulus_m(
+                             s.shear_modulus_m, s.shear_modulus_slip_m, cond.slip),
                          unit_weight_n_m3=full(s.density_kg_m3 * EARTH_GRAVITY_MPS2),
-                         c1=full(s.c1), c2=full(s.c2), c3=full(s.c3))
+                         c1=full(s.c1), c2=full(s.c2),
+                         c3=slip_soil_ding2015.exit_angle_coefficient(s.c3, s.c4, cond.slip))
 
     def _base_geometry(self, cond: Condition) -> Geometry:
         zeros = np.zeros(cond.slip.shape)

@@ -87,7 +87,9 @@ def model_to_dict(model: WheelModel) -> dict:
         effects[name] = {"enabled": name in model.effects, "law": effect.law,
                          **dataclasses.asdict(effect)}
     return {"model": {"gravity_mps2": model.gravity_mps2},
-            "wheel": dataclasses.asdict(model.wheel), "soil": dataclasses.asdict(model.soil),
+            "wheel": {k: v for k, v in dataclasses.asdict(model.wheel).items()
+                      if v is not None and v != ""},
+            "soil": dataclasses.asdict(model.soil),
             "effects": effects}
 
 

@@ -6,7 +6,10 @@ the exponent may vary (slip-sinkage effect). Shear strength Mohr-Coulomb
 ``c + sigma tan(phi)`` with the Janosi & Hanamoto (1961) shear modulus ``K``.
 ``c1, c2`` set the Wong & Reece (1967) maximum-stress angle
 ``theta_m = (c1 + c2 s) theta_1``; ``c3`` the rear (exit) angle
-``theta_2 = -c3 theta_1``.
+``theta_2 = -c3 theta_1``. ``shear_modulus_slip_m`` (K1) and ``c4`` make K and the exit
+angle grow with driving slip, ``K = K0 + K1 s`` (K0 = shear_modulus_m) and
+``theta_2 = -(c3 + c4 s) theta_1`` (Ding et al. 2015, J. Field Robotics 32(6);
+``terramechanics/slip_soil_ding2015.py``); both 0 by default.
 """
 
 from __future__ import annotations
@@ -28,6 +31,8 @@ class SoilParams:
     c1: float = 0.43
     c2: float = 0.32
     c3: float = 0.0
+    shear_modulus_slip_m: float = 0.0
+    c4: float = 0.0
     name: str = "custom"
     source: str = ""
 
@@ -38,6 +43,8 @@ class SoilParams:
             raise ValueError(f"soil {self.name!r}: need 0 <= phi < 90 deg and c >= 0")
         if self.kc <= 0 and self.kphi <= 0:
             raise ValueError(f"soil {self.name!r}: kc or kphi must be > 0")
+        if self.shear_modulus_m + self.shear_modulus_slip_m <= 0:
+            raise ValueError(f"soil {self.name!r}: K + K1 (shear_modulus_slip_m) must be > 0")
 
 
 _WR = "Wong & Reece 1967 (J. Terramech. 4(1)) c1=0.43, c2=0.32"

@@ -6,7 +6,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-EARTH_GRAVITY_MPS2 = 9.81
+from swtlab.domain.gravity import G0_MPS2
+
+#: the gravity the soil parameters hold at (their unit weight rho g): standard gravity
+EARTH_GRAVITY_MPS2 = G0_MPS2
 
 
 @dataclass(frozen=True)

@@ -92,7 +92,7 @@ def test_degree_choice_on_model_curves_is_low_with_the_sample_slips():
     assert len(fits) == 15  # 3 loads x 5 quantities
     assert {f.degree_choice for f in fits} == {"loo"}
     degrees = [f.degree for f in fits]
-    assert set(degrees) <= {3, 4} and degrees.count(3) >= 12  # 7 slips: cubic, some quartic
+    assert set(degrees) <= {3, 4} and degrees.count(3) >= 12  # 9 slips: cubic, some quartic
     assert not any(f.oscillates for f in fits)
     assert all(f.r2 > 0.99 for f in fits if f.quantity in ("dp_n", "torque_nm", "dp_over_w"))
 
@@ -138,11 +138,15 @@ def test_fit_record_carries_its_diagnostics():
     assert isinstance(fit, CurveFit)
     d = fit.to_dict()
     assert (d["wheel"], d["soil"], d["multipass"], d["load_n"]) == ("bb2", "bb2_sand", 0, 180.0)
-    assert (d["quantity"], d["unit"], d["degree"], d["n_points"]) == ("dp_n", "N", 3, 7)
+    assert (d["quantity"], d["unit"], d["degree"], d["n_points"]) == ("dp_n", "N", 3, 9)
     assert (d["slip_min"], d["slip_max"]) == (-0.1, 0.6)
     assert 0 < d["rmse"] < 1.5 and d["loo_rmse"] > d["rmse"] and d["r2"] > 0.999
     assert 1.0 < d["condition_number"] < 100.0  # Chebyshev basis: well conditioned
     assert len(d["coefficients"]) == 4
+    # the braked branch, chosen by LOO at a set degree: the model's braked side lies above
+    # its driven side at zero slip (DP -7.7 N at 0-, -11.0 N at 0 at 180 N), so J > 0
+    assert d["branch_choice"] == "loo" and set(d["branch_scores"]) == {"3+1", "3+2"}
+    assert d["step_below_zero"] > 0 and 0 < d["step_se"] < d["step_below_zero"]
 
 
 def test_dp_over_w_uses_the_measured_load():
@@ -195,7 +199,7 @@ def test_missing_values_leave_only_that_quantity():
     table = model_results_table(slips=TESTED_SLIPS + (0.02,))
     table.loc[table["slip"] == 0.02, "dp_n"] = np.nan  # e.g. a free-sled run: no tether
     fits = {(f.load_n, f.quantity): f for f in fit_results(table)}
-    assert fits[70.0, "dp_n"].n_points == 7 and fits[70.0, "torque_nm"].n_points == 8
+    assert fits[70.0, "dp_n"].n_points == 9 and fits[70.0, "torque_nm"].n_points == 10
     assert pd.isna(table["dp_n"]).sum() == 3
 
 
@@ -220,3 +224,66 @@ def test_the_results_table_of_swtlab_results_is_adapted():
     b = {(f.load_n, f.quantity): f for f in fit_results(ours.iloc[3:])}
     assert a.keys() == b.keys()
     assert all(a[k].coefficients == b[k].coefficients for k in a)
+
+
+BRANCH_SLIPS = np.linspace(-0.3, 0.6, 19)  # 6 braked slips, 13 driven ones (zero included)
+STEP_N, SLOPE_N = -6.0, 25.0  # hand-made branch: y += J + K s below zero slip
+
+
+def _stepped(slip):
+    """A hand-made curve with a step and a slope change at zero slip (no model involved)."""
+    slip = np.asarray(slip, dtype=float)
+    return horner(KNOWN[:4], slip) + np.where(slip < 0, STEP_N + SLOPE_N * slip, 0.0)
+
+
+def test_noise_free_step_and_slope_are_recovered_exactly():
+    fit = fit_curve(BRANCH_SLIPS, _stepped(BRANCH_SLIPS), degree=3, branch=2)
+    np.testing.assert_allclose(fit.coefficients, KNOWN[:4], rtol=1e-9, atol=1e-9)
+    assert fit.step_below_zero == pytest.approx(STEP_N, abs=1e-9)
+    assert fit.slope_below_zero == pytest.approx(SLOPE_N, abs=1e-8)
+    assert fit.branch_choice == "user" and fit.rmse < 1e-11 and not fit.oscillates
+    # the curve jumps at zero slip: zero itself belongs to the driven side
+    assert fit.evaluate(-1e-12) - fit.evaluate(0.0) == pytest.approx(STEP_N, abs=1e-9)
+
+
+def test_the_step_is_recovered_within_its_standard_error():
+    rng = np.random.default_rng(21)
+    se = np.full(BRANCH_SLIPS.size, 0.4)
+    fits = [fit_curve(BRANCH_SLIPS, _stepped(BRANCH_SLIPS) + rng.normal(0, se), se, degree=3,
+                      branch=2) for _ in range(400)]
+    step = np.array([f.step_below_zero for f in fits])
+    step_se = fits[0].step_se  # the same design and SEs every draw: the same SE
+    assert all(f.step_se == pytest.approx(step_se) for f in fits)
+    # unbiased (mean within 3 SE of the mean) and the stated SE is the scatter (+-10 %)
+    assert abs(step.mean() - STEP_N) < 3 * step_se / np.sqrt(step.size)
+    assert np.std(step, ddof=1) == pytest.approx(step_se, rel=0.1)
+    assert np.mean(np.abs(step - STEP_N) < step_se) == pytest.approx(0.683, abs=0.06)
+    slope = np.array([f.slope_below_zero for f in fits])
+    assert np.std(slope, ddof=1) == pytest.approx(fits[0].slope_se, rel=0.1)
+    # without standard errors the SE is scaled by the residual scatter: about the same
+    unweighted = fit_curve(BRANCH_SLIPS, _stepped(BRANCH_SLIPS) + rng.normal(0, se),
+                           degree=3, branch=2)
+    assert unweighted.step_se == pytest.approx(step_se, rel=0.5)
+
+
+def test_the_choice_takes_a_branch_only_where_the_data_have_one():
+    rng = np.random.default_rng(8)
+    se = np.full(BRANCH_SLIPS.size, 0.2)
+    noise = rng.normal(0, se)
+    stepped = fit_curve(BRANCH_SLIPS, _stepped(BRANCH_SLIPS) + noise, se)
+    smooth = fit_curve(BRANCH_SLIPS, horner(KNOWN[:4], BRANCH_SLIPS) + noise, se)
+    assert stepped.branch_choice == "loo" and stepped.degree == 3
+    assert abs(stepped.step_below_zero - STEP_N) < 3 * stepped.step_se
+    assert abs(stepped.slope_below_zero - SLOPE_N) < 3 * stepped.slope_se
+    assert (smooth.degree, smooth.step_below_zero, smooth.slope_below_zero) == (3, 0.0, 0.0)
+    assert {(d, b) for d, b, _ in smooth.branch_scores} >= {(3, 1), (3, 2)}
+
+
+def test_one_braked_run_cannot_carry_a_branch():
+    slip = np.array([-0.1, 0.0, 0.05, 0.1, 0.2, 0.35, 0.6, 0.8])
+    fit = fit_curve(slip, _stepped(slip), degree=3)
+    assert fit.branch_scores == () and fit.step_below_zero == 0.0
+    with pytest.raises(TooFewPointsError, match="2 distinct slips below zero"):
+        fit_curve(slip, _stepped(slip), degree=3, branch=1)
+    with pytest.raises(FittingError, match="branch 'yes': give 'auto', 0, 1 or 2"):
+        fit_curve(slip, _stepped(slip), degree=3, branch="yes")

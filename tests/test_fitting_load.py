@@ -26,6 +26,21 @@ def test_linear_interpolation_is_the_weighted_sum_of_the_curves():
     assert curve.fit_rmse < 1e-12
 
 
+def test_the_braked_branch_is_interpolated_with_the_values():
+    stepped = PowerCurve(HIGH.coefficients, -0.2, 0.8, step_below_zero=4.0, slope_below_zero=-30.0)
+    curve = interpolate_load({70.0: LOW, 180.0: stepped}, 120.0)
+    t = 50.0 / 110.0  # linear: the weighted sum, branch included (LOW has none)
+    assert curve.step_below_zero == pytest.approx(t * 4.0, abs=1e-10)
+    assert curve.slope_below_zero == pytest.approx(t * -30.0, abs=1e-9)
+    s = np.concatenate([np.linspace(-0.1, -1e-9, 20), np.linspace(0.0, 0.6, 20)])
+    np.testing.assert_allclose(curve.evaluate(s), (1 - t) * LOW.evaluate(s)
+                               + t * stepped.evaluate(s), rtol=0, atol=1e-10)
+    # a shared range that stays at or above zero slip needs no branch
+    driven = interpolate_load({70.0: PowerCurve(LOW.coefficients, 0.0, 0.6), 180.0: stepped},
+                              120.0)
+    assert (driven.step_below_zero, driven.slope_below_zero) == (0.0, 0.0)
+
+
 def test_pchip_across_three_loads_at_every_slip():
     curves = {70.0: LOW, 180.0: HIGH, 300.0: TOP}
     curve = interpolate_load(curves, 120.0)

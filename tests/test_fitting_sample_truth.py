@@ -41,8 +41,16 @@ def test_sample_campaign_120n_validation_from_true_stable_means():
     results = {r.quantity: r for r in validate_load_interpolation(table, 120.0)}
     dp = results["dp_n"]
     assert (dp.multipass, dp.n_points, dp.n_outside_slip_range) == (0, 5, 1)
-    assert dp.rmse_pct_of_range == pytest.approx(0.28, abs=0.02)  # goal: < 3 %
-    assert results["torque_nm"].rmse_pct_of_range < 1.0
+    # docs/fitting.md's number (python -m bench fitting_validation); the goal: < 3 %
+    assert dp.rmse_pct_of_range == pytest.approx(0.91, abs=0.02)
+    # Bounds as before at about 1.3-2x the measured numbers. With the truth's braked branch
+    # (Wong & Reece part II) fitted, sinkage (0.62 %), resistance (0.70 %) and DP/W (0.36 %)
+    # are tighter than before (1.70, 2.04, 0.47 %: bounds 2.0, 2.5, 1.0 -> 1.0, 1.0, 1.0).
+    # Torque is looser (0.47 % -> 1.86 %, bound 1.0 -> 2.5 %, still under the 3 % goal): at
+    # 180 N LOO's one-standard-error rule takes the quartic without a branch (5 parameters,
+    # LOO 0.80 N*m) over the cubic with step and slope (6, LOO 0.63 N*m) -- the choice, not
+    # the representation (the cubic with J and K gives 0.44 %).
+    assert results["torque_nm"].rmse_pct_of_range < 2.5
     assert results["dp_over_w"].rmse_pct_of_range < 1.0
-    assert results["sinkage_m"].rmse_pct_of_range < 2.0
-    assert results["resistance_n"].rmse_pct_of_range < 2.5
+    assert results["sinkage_m"].rmse_pct_of_range < 1.0
+    assert results["resistance_n"].rmse_pct_of_range < 1.0

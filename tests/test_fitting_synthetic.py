@@ -11,7 +11,11 @@ import pytest
 
 from terramechanics import shipped_model
 
-TESTED_SLIPS = (-0.10, 0.0, 0.05, 0.10, 0.20, 0.35, 0.60)  # 0.90: no stable phase (dig-in)
+# The sample campaign's multipass-0 slips: speed control at -10 ... 60 % (90 %: no stable
+# phase, dig-in), the towed run (about -5.7 %) and the free-sled run (about 3 %). The towed
+# run is the second point on the braked side: a braked branch (Wong & Reece 1967 part II,
+# fitted with its own step and slope, docs/fitting.md) is undetermined by one point alone.
+TESTED_SLIPS = (-0.10, -0.057, 0.0, 0.03, 0.05, 0.10, 0.20, 0.35, 0.60)
 VALIDATION_SLIPS = (-0.05, 0.03, 0.15, 0.45, 0.75)
 TESTED_LOADS_N = (70.0, 180.0, 300.0)
 MODEL = shipped_model("bb2_sand")
@@ -78,8 +82,9 @@ def test_noise_free_validation_numbers_are_those_of_docs_fitting_md():
 
     pct = {r.quantity: r.rmse_pct_of_range
            for r in validate_load_interpolation(sample_like_table(None), 120.0)}
-    documented = {"dp_n": 0.32, "torque_nm": 0.48, "sinkage_m": 1.62, "resistance_n": 2.30,
-                  "dp_over_w": 0.46}
+    # docs/fitting.md, "Validation at 120 N" (python -m bench fitting_validation)
+    documented = {"dp_n": 0.26, "torque_nm": 0.29, "sinkage_m": 0.67, "resistance_n": 0.69,
+                  "dp_over_w": 0.20}
     for quantity, value in documented.items():
         assert pct[quantity] == pytest.approx(value, abs=0.01), quantity
 

@@ -14,6 +14,7 @@ from sim_gap.calibrate import calibrate_soil, predict_with_se
 from sim_gap.holdout import holdout_dp, holdout_summary
 from sim_gap.measured import from_cmu_smooth_runs
 from sim_gap.priors import published_soils, soil_prior
+from swtlab.domain import G0_MPS2
 
 CMU_RUNS = Path(__file__).resolve().parents[2] / "shared/data/cmu-3d-terramechanics/smooth_runs.csv"
 START = Path(__file__).parents[1] / "sim_gap" / "models" / "cmu_smooth_start.toml"
@@ -39,7 +40,8 @@ def synthetic_points(model, slips, loads_n=(60.0, 300.0)):
     load, slip = (a.ravel() for a in np.meshgrid(np.asarray(loads_n), slips))
     out = model.curves(load, slip)
     table = pd.DataFrame({"run_id": [f"r{i}" for i in range(len(slip))], "load_set_n": load,
-                          "load_n": load, "multipass": 0, "gravity_mps2": 9.81, "slip": slip,
+                          "wheel_load_n": load, "multipass": 0, "gravity_mps2": G0_MPS2,
+                          "slip": slip,
                           "dp_n": out["dp_n"], "dp_n_se": 0.5,
                           "sinkage_m": out["sinkage_m"], "sinkage_m_se": 2e-4})
     table.attrs.update(source="synthetic", sinkage_relative=False)

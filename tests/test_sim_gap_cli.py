@@ -43,7 +43,7 @@ def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
     assert report["shrink_pct"]["sinkage_m"] > 50.0
     assert all({"slip_band", "quantity", "z", "significant"} <= set(r) for r in report["regions"])
     html = (tmp_path / "gap.html").read_text()
-    assert "data:image/png;base64," in html and "slip_sinkage" in html
+    assert "data:image/png;base64," in html and "Verdict: the simulation lacks slip sinkage" in html
     assert "verdict: slip_sinkage" in capsys.readouterr().out
     # recorded in the measured database, and shown by the campaign report
     with open_database(db)() as session:
@@ -53,7 +53,7 @@ def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
     page = tmp_path / "report.html"
     assert main(["report", "--db", db, "-o", str(page), "--quiet"]) == 0
     section = page.read_text().split('<section id="gap">', 1)[1].split("</section>", 1)[0]
-    assert "Sim-to-real gap" in section and "slip_sinkage" in section
+    assert "Sim-to-real gap" in section and "Verdict: the simulation lacks slip sinkage" in section
     assert section.count("data:image/png;base64,") >= 1
 
 

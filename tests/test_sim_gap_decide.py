@@ -30,14 +30,14 @@ def synthetic_points(truth: tm.WheelModel, seed: int = 0, loads=(80.0, 180.0, 30
     load, slip, mp, g = (a.ravel() for a in grids)
     c = truth.curves(load, slip, mp, g)
     points = pd.DataFrame({"run_id": [f"r{i}" for i in range(load.size)], "load_set_n": load,
-                           "load_n": load, "multipass": mp.astype(int), "gravity_mps2": g,
-                           "slip": slip})
+                           "wheel_load_n": load, "multipass": mp.astype(int),
+                           "gravity_mps2": g, "slip": slip})
     noise = {"dp_n": 0.005 * load, "torque_nm": 0.005 * load * 0.125, "sinkage_m": 1e-4,
              "resistance_n": 0.005 * load}
     for q, sd in noise.items():
         points[q] = c[q] + rng.normal(0.0, 1.0, load.size) * sd
         points[f"{q}_se"] = 0.2 * np.broadcast_to(sd, load.shape)
-    points.attrs.update(source="synthetic", sinkage_relative=False)
+    points.attrs.update(source="synthetic", wheel=truth.wheel, sinkage_relative=False)
     return points
 
 
@@ -71,7 +71,8 @@ def test_injected_effect_is_found(effects, expected):
 
 def test_multipass_on_one_level_is_untestable_with_the_contrast_it_needs():
     truth = BASE.with_effects(multipass={"stiffness_gain_per_pass": 0.3})
-    points = synthetic_points(truth, multipass=(0,), slips=(0.2, 0.5))
+    # 9 points: three per soil parameter, the fewest that can call "no missing effect"
+    points = synthetic_points(truth, multipass=(0,), slips=(0.2, 0.35, 0.5))
     report = diagnose(points, Simulated(BASE), ["multipass", "bulldozing"], FAST)
     assert "multipass" in report["untestable_effects"]
     assert "second multipass level" in report["untestable_effects"]["multipass"]
@@ -84,9 +85,9 @@ def test_without_the_contrast_the_call_is_inconclusive_with_a_test_to_run():
     diagnosis must not name either, and proposes the test that separates them."""
     truth = BASE.with_soil(kphi=2.3e7).with_effects(grousers={"shear_radius_factor": 0.8})
     points = synthetic_points(truth, loads=(180.0,), multipass=(0,))
-    points = points[["run_id", "load_set_n", "load_n", "multipass", "gravity_mps2", "slip",
+    points = points[["run_id", "load_set_n", "wheel_load_n", "multipass", "gravity_mps2", "slip",
                      "dp_n", "dp_n_se"]]
-    points.attrs.update(source="synthetic", sinkage_relative=False)
+    points.attrs.update(source="synthetic", wheel=truth.wheel, sinkage_relative=False)
     report = diagnose(points, Simulated(BASE), ["grousers", "slip_sinkage"], FAST)
     assert report["verdict"] == "inconclusive"
     assert report["folds"][0].startswith("slip band")

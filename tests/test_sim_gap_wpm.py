@@ -19,12 +19,18 @@ QUANTITIES = (("dp_n", "N"), ("torque_nm", "N*m"), ("sinkage_m", "m"), ("resista
 
 
 def write_wpm(model: tm.WheelModel, path: Path, loads=(80.0, 180.0, 300.0), mps=(0, 1),
-              rmse: float = 0.2) -> Path:
-    """A simulator's WPM CSV: degree-5 polynomials of the model's curves on slip 0-0.8."""
+              rmse: float = 0.2, geometry: bool = True) -> Path:
+    """A simulator's WPM CSV: degree-5 polynomials of the model's curves on slip 0-0.8, with
+    the model's wheel in the ``wheel_geometry`` header (or, as older files, without it)."""
     slips = np.linspace(0.0, 0.8, 33)
-    lines = ["# format: swtlab-wpm/1", "# generator: test simulator",
-             "soil,wheel,multipass,load_n,quantity,unit,degree,slip_min,slip_max,"
-             "a0,a1,a2,a3,a4,a5,a6,a7,n_points,rmse"]
+    w = model.wheel
+    lines = ["# format: swtlab-wpm/1", "# generator: test simulator"]
+    if geometry:
+        lines.append(f'# wheel_geometry: {{"bb2": {{"radius_m": {w.radius_m}, "width_m": '
+                     f'{w.width_m}, "grouser_count": {w.grouser_count}, "grouser_height_m": '
+                     f'{w.grouser_height_m}, "stiffness_n_per_mm": null}}}}')
+    lines.append("soil,wheel,multipass,load_n,quantity,unit,degree,slip_min,slip_max,"
+                 "a0,a1,a2,a3,a4,a5,a6,a7,n_points,rmse")
     for mp in mps:
         for load in loads:
             c = model.curves(load, slips, mp)
@@ -42,12 +48,13 @@ def test_wpm_simulation_adds_effects_as_model_corrections(tmp_path):
     assert sim.wpm is not None and sim.missing_effects() == list(tm.EFFECTS)
     points = synthetic_points(BASE, loads=(180.0,), slips=(0.2, 0.5), multipass=(0,))
     plain = sim.predict(points, {})
-    direct = sim_model.curves(points["load_n"], points["slip"], points["multipass"])
+    direct = sim_model.curves(points["wheel_load_n"], points["slip"], points["multipass"])
     np.testing.assert_allclose(plain["dp_n"], direct["dp_n"], atol=0.05)
     values = {"effects.bulldozing.coefficient": 1.0}
     with_effect = sim.predict(points, values)
-    correction = (BASE.with_parameters(values).curves(points["load_n"], points["slip"])["dp_n"]
-                  - BASE.curves(points["load_n"], points["slip"])["dp_n"])
+    load, slip = points["wheel_load_n"], points["slip"]
+    correction = (BASE.with_parameters(values).curves(load, slip)["dp_n"]
+                  - BASE.curves(load, slip)["dp_n"])
     np.testing.assert_allclose(with_effect["dp_n"] - plain["dp_n"], correction, atol=1e-9)
     assert np.all(correction < -1.0)                 # bulldozing costs drawbar pull
 
@@ -67,7 +74,7 @@ def test_measured_from_wpm_csv_samples_curves_with_rmse_as_se(tmp_path):
     points = load_measured(str(path))
     assert len(points) == 2 * 9 and points["dp_n_se"].eq(0.3).all()
     assert points["slip"].min() == 0.0 and points["slip"].max() == pytest.approx(0.8)
-    ref = BASE.curves(points["load_n"], points["slip"])["dp_n"]
+    ref = BASE.curves(points["wheel_load_n"], points["slip"])["dp_n"]
     np.testing.assert_allclose(points["dp_n"], ref, atol=0.1)
     assert from_wpm_csv(path, gravity_mps2=3.71)["gravity_mps2"].eq(3.71).all()
 
@@ -81,3 +88,23 @@ def test_cmu_smooth_runs_adapter():
     row = points[points["slip"].between(-0.20039, -0.20038)].iloc[0]
     assert row["dp_n"] == pytest.approx(-7.63951) and row["sinkage_m"] == pytest.approx(0.01457)
     assert row["dp_n_se"] == pytest.approx(0.845539)
+
+
+def test_a_wpm_file_without_wheel_geometry_cannot_stand_for_a_wheel(tmp_path):
+    path = write_wpm(BASE, tmp_path / "old.csv", geometry=False)
+    with pytest.raises(ValueError, match="no wheel geometry.*'bb2'.*radius"):
+        load_simulated(path)
+    with pytest.raises(ValueError, match="no wheel geometry"):
+        load_measured(str(path))
+
+
+def test_the_wpm_simulation_models_the_wheel_of_its_file(tmp_path):
+    small = BASE.with_wheel(radius_m=0.09, width_m=0.08, grouser_count=0, grouser_height_m=0.0)
+    sim = load_simulated(write_wpm(small, tmp_path / "sim.csv"))
+    assert (sim.radius_m, sim.wheel.width_m, sim.wheel.grouser_count) == (0.09, 0.08, 0)
+    points = synthetic_points(BASE, loads=(180.0,), slips=(0.2,), multipass=(0,))
+    values = {"effects.bulldozing.coefficient": 1.0}
+    correction = sim.predict(points, values)["dp_n"] - sim.predict(points, {})["dp_n"]
+    direct = (small.with_parameters(values).curves(180.0, 0.2)["dp_n"]
+              - small.curves(180.0, 0.2)["dp_n"])
+    np.testing.assert_allclose(correction, direct, rtol=1e-9)

@@ -16,9 +16,10 @@ import sys
 import numpy as np
 import pytest
 
-from terramechanics import EFFECTS, LETE_SAND, Wheel, WheelModel, load_model
+from terramechanics import EARTH_GRAVITY_MPS2, EFFECTS, LETE_SAND, Wheel, WheelModel, load_model
 from terramechanics.effects import BulldozingBekker1969, GrousersBekker1956, make_effect
 from terramechanics.model_file import SHIPPED_MODELS
+from swtlab.domain import MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2
 
 BB2_FILE = SHIPPED_MODELS / "bb2_sand.toml"
 SLIPS = np.linspace(0.0, 0.9, 19)
@@ -68,9 +69,9 @@ def test_slip_sinkage_sinks_more_at_high_slip(bb2):
 
 def test_reece_reduced_gravity_at_the_same_load(bb2):
     model = bb2.with_effects(reduced_gravity={"law": "reece1965"})
-    earth = model.curves(180.0, SLIPS, gravity_mps2=9.81)
-    moon = model.curves(180.0, SLIPS, gravity_mps2=1.62)
-    mars = model.curves(180.0, SLIPS, gravity_mps2=3.71)
+    earth = model.curves(180.0, SLIPS, gravity_mps2=EARTH_GRAVITY_MPS2)
+    moon = model.curves(180.0, SLIPS, gravity_mps2=MOON_GRAVITY_MPS2)
+    mars = model.curves(180.0, SLIPS, gravity_mps2=MARS_GRAVITY_MPS2)
     traction_loss = lambda c: 1 - c["dp_n"].max() / earth["dp_n"].max()  # noqa: E731
     assert 0.15 <= traction_loss(moon) <= 0.25  # about 20 %
     assert 0.05 <= traction_loss(mars) <= 0.11  # 5-10 %

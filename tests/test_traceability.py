@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
+import importlib.metadata
+
 import shutil
 from pathlib import Path
 
@@ -86,7 +89,10 @@ def test_conditions_and_calibrations_are_recorded(db_url):
         assert zeros == pytest.approx(run.metadata.zero)
         assert raw.size_bytes == path.stat().st_size
         assert {s["topic"] for s in raw.channel_summary} == set(run.streams)
-        assert session.scalars(select(ProcessingRecord)).one().swtlab_version
+        record = session.scalars(select(ProcessingRecord)).one()
+        assert record.swtlab_version == importlib.metadata.version("swtlab")
+        lock = Path(__file__).resolve().parents[1] / "requirements.lock"  # read apart here
+        assert record.lock_sha256 == hashlib.sha256(lock.read_bytes()).hexdigest()
 
 
 def test_migrations_go_up_and_down(db_url):

@@ -43,7 +43,19 @@ def test_transient_settles_in_about_25_s():
     t = run.signals["t_s"]
     assert TL.window_start_s == pytest.approx(29.0)
     assert _at(run, "sinkage_m", 3.0) < 0.8 * z_ss
-    assert abs(np.interp(10.0, t, trend) - run.steady["dp_n"]) > 0.05 * run.steady["dp_n"]
+    # The DP transient is the resistance following sinkage from the static sinkage
+    # (0.6 x the zero-slip sinkage) to the steady one: amplitude R (1 - z_start / z_ss), decaying
+    # with the time constant settle_time_s / 5 = 5 s (module docstring). Hand-calculated from
+    # the law's steady values, not from the run: 15.9 N at 180 N and 30 % slip, 3.2 N left
+    # at 10 s. (The old check, "more than 5 % of the steady DP at 10 s", measured the law's
+    # R/DP ratio rather than the settling: the published grouser law's 8 % higher steady DP
+    # put it at 4.7 %.)
+    z_start = DYN.static_sinkage_ratio * float(LAW.evaluate(180.0, 0.0, 0, 9.81)["sinkage_m"])
+    amplitude = run.steady["resistance_n"] * (1.0 - z_start / z_ss)
+    left = amplitude * np.exp(-(10.0 - TL.motion_start_s) / (TL.settle_time_s / 5.0))
+    # within 15 %: thrust still builds (shear, 1.5 s) by 0.3 N; a 4 s or 6 s constant is 30 % off
+    assert np.interp(10.0, t, trend) - run.steady["dp_n"] == pytest.approx(left, rel=0.15)
+    assert left > 0.01 * run.steady["dp_n"]  # not settled at 10 s by the 1 % rule below
     assert np.interp(TL.window_start_s, t, trend) == pytest.approx(run.steady["dp_n"], rel=0.01)
     assert _at(run, "omega_radps", 20.0) == pytest.approx(0.0111111 / 0.7 / 0.125, rel=1e-4)
 
@@ -96,7 +108,7 @@ def test_suspension_angle_gives_the_sinkage():
     sus = Suspension(arm_length_m=0.6, angle_zero_rad=0.05)
     rigid = suspension_angle_rad(0.02, 180.0, replace(BB2_WHEEL, stiffness_n_per_mm=None), sus)
     assert -0.6 * (np.sin(rigid) - np.sin(0.05)) == pytest.approx(0.02)
-    flexible = Wheel("flex", 0.125, 0.112, 12, 0.0092, stiffness_n_per_mm=60.0)
+    flexible = Wheel(0.125, 0.112, 12, 0.0092, stiffness_n_per_mm=60.0, name="flex")
     angle = suspension_angle_rad(0.02, 180.0, flexible, sus)
     hub_height = 0.6 * (np.sin(angle) - np.sin(0.05))
     assert -hub_height - 180.0 / (1000.0 * 60.0) == pytest.approx(0.02)

@@ -55,6 +55,22 @@ def test_unreachable_dp_text_and_json(capsys, wpm_csv):
     assert json.loads(out)["slip"] is None and json.loads(out)["status"] == "below_min"
 
 
+def test_a_dp_inside_the_jump_at_zero_slip(capsys, tmp_path):
+    from wpm_export.schema import BRANCH_COLUMNS, COLUMNS
+
+    path = tmp_path / "step.csv"  # hand-made: DP = 100 s, 5 N lower on the braked side
+    path.write_text("# format: swtlab-wpm/1\n" + ",".join(COLUMNS + BRANCH_COLUMNS) + "\n"
+                    "sand,w,0,100.0,dp_n,N,3,-0.2,0.6,0,100,0,0,,,,,9,0.1,-5,0\n")
+    code, out, _ = _run(capsys, str(path), "--load", "100", "--dp", "-2")
+    assert code == 0 and "dp_n = -2 N at slip 0: inside the curve's jump at zero slip" in out
+    code, out, _ = _run(capsys, str(path), "--load", "100", "--dp", "-2", "--json")
+    answer = json.loads(out)
+    assert (answer["slip"], answer["status"]) == (0.0, "at_step")
+    assert answer["value"] == pytest.approx(-2.0)
+    code, out, _ = _run(capsys, str(path), "--load", "100", "--dp", "-10", "--json")
+    assert json.loads(out)["slip"] == pytest.approx(-0.05)  # 100 s - 5 = -10 on the braked side
+
+
 @pytest.mark.parametrize("option, quantity", [("--torque", "torque_nm"), ("--sinkage", "sinkage_m"),
                                               ("--resistance", "resistance_n")])
 def test_other_quantities(capsys, wpm_csv, option, quantity):

@@ -11,10 +11,12 @@ import pytest
 from fitting import fit_results
 from wpm_export import (COLUMNS, FORMAT, WpmFormatError, inputs_sha256, read_wpm_csv,
                         write_wpm_csv)
+from wpm_export.schema import BRANCH_COLUMNS
 from test_fitting_synthetic import model_results_table
 
-HEADER = ",".join(COLUMNS)
+HEADER = ",".join(COLUMNS)  # the layout without the braked-branch columns, still read
 GOOD_ROW = "sand,bb2,0,180,dp_n,N,3,-0.1,0.6,-11.0,200.0,-230.0,80.0,,,,,7,0.4"
+BRANCH_HEADER = ",".join(COLUMNS + BRANCH_COLUMNS)  # what swtlab writes
 
 
 @pytest.fixture(scope="module")
@@ -43,6 +45,8 @@ def test_round_trip_gives_the_same_curves(tmp_path, table, fits):
         assert (c.degree, c.slip_min, c.slip_max, c.n_points, c.unit) == (
             f.degree, f.slip_min, f.slip_max, f.n_points, f.unit)
         assert c.rmse == f.rmse
+        assert (c.step_below_zero, c.slope_below_zero) == (f.step_below_zero,
+                                                           f.slope_below_zero)
         np.testing.assert_allclose(c.evaluate(s), f.evaluate(s), rtol=0, atol=1e-12)
 
 
@@ -51,7 +55,7 @@ def test_rows_are_sorted_and_unused_coefficients_empty(tmp_path, fits):
     write_wpm_csv(fits, path, "0" * 64, "0.1.0")
     lines = path.read_text().splitlines()
     assert lines[:4] == [f"# format: {FORMAT}", "# swtlab_version: 0.1.0",
-                         f"# inputs_sha256: {'0' * 64}", HEADER]
+                         f"# inputs_sha256: {'0' * 64}", BRANCH_HEADER]
     first = lines[4].split(",")
     assert first[:7] == ["bb2_sand", "bb2", "0", "70.0", "dp_n", "N", first[6]]
     degree = int(first[6])
@@ -87,6 +91,19 @@ def test_a_file_from_another_tool_written_to_the_page_loads(tmp_path):
     assert header == {"format": FORMAT, "generator": "other-tool 2.1"}
     assert curve.soil == "sand, fine" and curve.coefficients == (-11.0, 200.0, -230.0, 80.0)
     assert curve.evaluate(0.5) == pytest.approx(-11 + 100 - 57.5 + 10)
+    assert (curve.step_below_zero, curve.slope_below_zero) == (0.0, 0.0)  # no such columns
+
+
+def test_the_braked_branch_columns_are_read_and_evaluated(tmp_path):
+    path = tmp_path / "branch.csv"
+    path.write_text(f"# format: {FORMAT}\n{BRANCH_HEADER}\n{GOOD_ROW},3.0,-20.0\n")
+    _, (curve,) = read_wpm_csv(path)
+    assert (curve.step_below_zero, curve.slope_below_zero) == (3.0, -20.0)
+    p = -11.0 + 200.0 * -0.05 - 230.0 * 0.0025 + 80.0 * -0.05 ** 3  # the polynomial at -5 %
+    assert curve.evaluate(-0.05) == pytest.approx(p + 3.0 - 20.0 * -0.05, abs=1e-12)
+    assert curve.evaluate(0.0) == -11.0  # zero slip: the driven side
+    message = _bad(tmp_path, f"{GOOD_ROW},x,0", f"# format: {FORMAT}\n{BRANCH_HEADER}\n")
+    assert message.startswith(":3: step_below_zero 'x' is not a number")
 
 
 def _bad(tmp_path, body: str, prefix: str = f"# format: {FORMAT}\n{HEADER}\n") -> str:
@@ -153,4 +170,45 @@ def test_the_example_of_the_format_page_reads_and_evaluates_as_stated():
     example = page.split("```text\n", 1)[1].split("```", 1)[0]
     header, curves = parse_wpm_csv(example, "docs/wpm-csv.md")
     assert header["format"] == FORMAT and len(curves) == 4
-    assert curves[0].evaluate(0.2) == pytest.approx(12.63, abs=0.005)
+    assert curves[0].evaluate(0.2) == pytest.approx(13.11, abs=0.005)
+    assert curves[0].evaluate(-0.05) == pytest.approx(-7.52, abs=0.005)  # braked branch
+    assert (curves[3].step_below_zero, curves[3].slope_below_zero) == (0.0, 0.0)
+
+
+GEOMETRY = ('# wheel_geometry: {"bb2": {"radius_m": 0.125, "width_m": 0.112, "grouser_count": 12, '
+            '"grouser_height_m": 0.0092, "stiffness_n_per_mm": null}}')
+
+
+def test_wheel_geometry_round_trips_and_old_files_still_read(tmp_path, table, fits):
+    from swtlab.domain import Wheel
+    from wpm_export import WheelPerformanceModule
+
+    wheel = Wheel(0.125, 0.112, 12, 0.0092, stiffness_n_per_mm=30.0, name=fits[0].wheel)
+    write_wpm_csv(fits, tmp_path / "new.csv", inputs_sha256(table), "0.1.0",
+                  wheels={wheel.name: wheel})
+    assert WheelPerformanceModule.load(tmp_path / "new.csv").wheel() == wheel
+    write_wpm_csv(fits, tmp_path / "old.csv", inputs_sha256(table), "0.1.0")
+    old = WheelPerformanceModule.load(tmp_path / "old.csv")
+    dp = next(f for f in fits if f.quantity == "dp_n")
+    assert old.wheels == {}   # every WPM query still answers
+    assert old.at_slip(0.2, dp.load_n, multipass=dp.multipass)["dp_n"] == pytest.approx(
+        dp.evaluate(0.2), rel=1e-12)
+    with pytest.raises(ValueError, match="no wheel geometry .* needs wheel"):
+        old.wheel(needed_for="the gap diagnosis")
+    with pytest.raises(ValueError, match="no geometry for wheel"):
+        write_wpm_csv(fits, tmp_path / "x.csv", inputs_sha256(table), "0.1.0", wheels={})
+
+
+@pytest.mark.parametrize("line, problem", [
+    ("# wheel_geometry: {bb2}", "wheel_geometry is not JSON"),
+    (GEOMETRY.replace(', "stiffness_n_per_mm": null', ""), r"missing \['stiffness_n_per_mm'\]"),
+    (GEOMETRY.replace("0.125", "-0.125"), "radius_m -0.125 must be > 0"),
+    (GEOMETRY.replace('"bb2"', '"other"'), r"lacks wheel\(s\) \['bb2'\]"),
+])
+def test_malformed_wheel_geometry_names_the_line(tmp_path, line, problem):
+    from wpm_export import parse_wpm_csv
+
+    text = ("# format: swtlab-wpm/1\n" + line + "\n" + ",".join(COLUMNS) + "\n"
+            "sand,bb2,0,70.0,dp_n,N,3,-0.1,0.6,1,2,3,4,,,,,7,0.1\n")
+    with pytest.raises(WpmFormatError, match=f"<t>:2: .*{problem}"):
+        parse_wpm_csv(text, "<t>")

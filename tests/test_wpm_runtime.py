@@ -55,6 +55,35 @@ def test_the_smallest_slip_is_returned_when_a_peaked_curve_reaches_the_target_tw
     assert found.slip[1] == pytest.approx(0.5, abs=1e-7) and found.status[1] == "ok"
 
 
+def test_targets_inside_the_jump_at_zero_slip_are_given_at_zero_slip():
+    # hand-made: DP = 100 s driven, 100 s - 5 + 20 s braked (J = -5 N, K = 20 N): the curve
+    # rises to -5 N at zero slip from below, jumps to 0 N, rises on
+    stepped = WpmCurve((0.0, 100.0, 0.0, 0.0), -0.2, 0.6, soil="s", wheel="w", multipass=0,
+                       load_n=100.0, quantity="dp_n", unit="N", n_points=9, rmse=0.0, line=3,
+                       step_below_zero=-5.0, slope_below_zero=20.0)
+    wpm = WheelPerformanceModule([stepped])
+    found = wpm.slip_for("dp_n", [-17.0, -4.0, -2.5, -1.0, 30.0, -30.0, 61.0], 100.0)
+    np.testing.assert_allclose(found.slip[:5], [-0.1, 0.0, 0.0, 0.0, 0.3], atol=1e-12)
+    assert found.status.tolist() == ["ok"] + ["at_step"] * 3 + ["ok", "below_min", "above_max"]
+    assert found.reached.tolist() == [True] * 5 + [False] * 2
+    np.testing.assert_allclose(found.value[:5], [-17.0, -4.0, -2.5, -1.0, 30.0], atol=1e-12)
+    assert found.value[5] == pytest.approx(-29.0) and found.value[6] == pytest.approx(60.0)
+    # the two ends of the jump are values of the curve: reached, at zero slip
+    ends = solve_slip([stepped.coefficients], [0, 0], [-5.0, 0.0], -0.2, 0.6, [[-5.0, 20.0]])
+    np.testing.assert_allclose(ends.slip, 0.0, atol=1e-15)
+    assert ends.status.tolist() == ["ok", "ok"]
+    # the same as the dense brute force, across both sides
+    s = np.linspace(-0.2, 0.6, 800_001)
+    v = stepped.evaluate(s)
+    for target in (-20.0, -7.3, 12.0):
+        hit = (v[:-1] - target) * (v[1:] - target) <= 0
+        assert float(wpm.slip_for("dp_n", target, 100.0).slip) == pytest.approx(
+            s[np.argmax(hit)], abs=2e-6)
+    # a jump down is passed on the braked side first: the smallest slip is braked
+    down = solve_slip([[0.0, 100.0, 0.0, 0.0]], [0], [2.0], -0.2, 0.6, [[5.0, 0.0]])
+    assert float(down.slip[0]) == pytest.approx(-0.03) and down.status[0] == "ok"
+
+
 def test_unreachable_dp_gives_100_percent_slip_and_the_maximum(wpm):
     curve = wpm.curve("dp_n", 120.0, multipass=0)
     s = np.linspace(curve.slip_min, curve.slip_max, 2_000_001)

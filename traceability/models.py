@@ -18,11 +18,13 @@ class Base(DeclarativeBase):
 
 
 class ProcessingRecord(Base):
-    """Who made a row: swtlab version, pipeline stage, its parameters, when."""
+    """Who made a row: swtlab version and the sha256 of the lock file it was installed from
+    (None where there was none, e.g. a wheel install), pipeline stage, its parameters, when."""
 
     __tablename__ = "processing_record"
     id: Mapped[int] = mapped_column(primary_key=True)
     swtlab_version: Mapped[str] = mapped_column(String(40))
+    lock_sha256: Mapped[str | None] = mapped_column(String(64), nullable=True)
     stage: Mapped[str] = mapped_column(String(40))
     parameters: Mapped[dict] = mapped_column(JSON, default=dict)
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True))

@@ -6,6 +6,8 @@ import pandas as pd
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
+from swtlab.domain.results import COLUMNS, check_results, wheel_columns
+
 from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult, Soil,
                                  StableWindow, TestCondition, Wheel)
 
@@ -25,7 +27,7 @@ def latest_results(session: Session) -> pd.DataFrame:
                      .group_by(RunResult.raw_file_id).subquery())
     rows = session.execute(
         select(Campaign.name, Run.run_id, RawFile.version, RawFile.path, RawFile.sha256,
-               Wheel.name, Soil.name, TestCondition, RunResult, StableWindow)
+               Wheel, Soil.name, TestCondition, RunResult, StableWindow)
         .join(Run.campaign).join(Run.condition).join(TestCondition.wheel)
         .join(TestCondition.soil)
         .join(RawFile, RawFile.run_pk == Run.id)
@@ -47,8 +49,9 @@ def latest_results(session: Session) -> pd.DataFrame:
         cond, result, window = row.TestCondition, row.RunResult, row.StableWindow
         records.append({
             "campaign": row[0], "run_id": row.run_id, "raw_file_version": row.version,
-            "raw_file_path": row.path, "raw_file_sha256": row.sha256, "wheel": row[5],
-            "soil": row[6], "mode": cond.mode, "multipass": cond.multipass,
+            "raw_file_path": row.path, "raw_file_sha256": row.sha256,
+            **wheel_columns(row.Wheel), "soil": row[6], "mode": cond.mode,
+            "multipass": cond.multipass,
             "load_set_n": cond.load_n, "slip_setpoint": cond.slip_setpoint,
             "velocity_set_mps": cond.velocity_mps, "gravity_mps2": cond.gravity_mps2,
             "steer_deg": cond.steer_deg, "status": result.status,
@@ -57,4 +60,5 @@ def latest_results(session: Session) -> pd.DataFrame:
             "window_method": window.method, "no_window_reason": window.reason,
             **by_result.get(result.id, {}), **result.oscillation,
             "result_id": result.id})
-    return pd.DataFrame.from_records(records)
+    return check_results(pd.DataFrame.from_records(records, columns=None if records
+                                                   else list(COLUMNS)))

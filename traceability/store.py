@@ -16,7 +16,7 @@ from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
 from traceability.hashing import content_sha256
-from traceability.provenance import swtlab_version
+from traceability.provenance import lock_sha256, swtlab_version
 from traceability.models import (Calibration, Campaign, ProcessingRecord, RawFile, Run, Soil,
                                  TestCondition, Wheel)
 
@@ -29,7 +29,8 @@ class StoreOutcome(enum.Enum):
 
 def new_processing_record(session: Session, stage: str,
                           parameters: dict[str, Any]) -> ProcessingRecord:
-    record = ProcessingRecord(swtlab_version=swtlab_version(), stage=stage,
+    record = ProcessingRecord(swtlab_version=swtlab_version(), lock_sha256=lock_sha256(),
+                              stage=stage,
                               parameters=json.loads(json.dumps(parameters, default=str)),
                               created_at=datetime.now(timezone.utc))
     session.add(record)

@@ -59,7 +59,10 @@ def store_fits(session: Session, table: pd.DataFrame, fits: list[Any],
                 slip_max=fit.slip_max, n_points=fit.n_points, rmse=fit.rmse,
                 diagnostics={k: d[k] for k in ("r2", "loo_rmse", "condition_number",
                                                "degree_choice", "degree_scores", "weighting",
-                                               "oscillates", "max_departure")},
+                                               "oscillates", "max_departure",
+                                               "step_below_zero", "slope_below_zero",
+                                               "step_se", "slope_se", "branch_choice",
+                                               "branch_scores")},
                 processing=record,
                 inputs=list(session.scalars(select(RunResult).where(
                     RunResult.id.in_(result_ids)))))

@@ -11,7 +11,7 @@ Layout of the work folder::
     labels/labels.json            hidden effect sets, laws and strengths (only the scorer)
     labels/c000/truth/...         the signal model's per-run truth, moved out of the campaign
 
-Each campaign: loads x slips x multipass {0, 1} x gravity {9.81, 3.71}, so that every effect
+Each campaign: loads x slips x multipass {0, 1} x gravity {g0, Mars}, so that every effect
 has the contrast it needs (docs/gap-report.md, "Identifiability").
 
 Laws of the truth (``truth_laws``): campaign i makes each of its effects with law
@@ -40,9 +40,8 @@ import numpy as np
 
 import terramechanics as tm
 from sim_gap.vocabulary import EFFECT_NAMES
+from swtlab.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
 
-STANDARD_GRAVITY_MPS2 = 9.80665
-MARS_GRAVITY_MPS2 = 3.71
 TRUTH_LAWS = ("in-family", "held-out")
 SIGNAL_MODELS = ("testbed", "second")
 #: hidden effect strengths, per law, drawn uniformly in these ranges; the ranges of the
@@ -77,7 +76,7 @@ class Design:
     loads_n: tuple[float, ...] = (80.0, 180.0, 300.0)
     slips: tuple[float, ...] = (0.1, 0.25, 0.4, 0.55, 0.7)
     multipass: tuple[int, ...] = (0, 1)
-    gravity_mps2: tuple[float, ...] = (STANDARD_GRAVITY_MPS2, MARS_GRAVITY_MPS2)
+    gravity_mps2: tuple[float, ...] = (G0_MPS2, MARS_GRAVITY_MPS2)
     duration_s: float = 60.0
 
 

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from virtual_testbed.law import STANDARD_GRAVITY_MPS2
-
-MODES = ("speed_control", "free_sled", "towed", "steered")
+from swtlab.domain import G0_MPS2, MODES
 #: modes whose slip the testbed imposes through the wheel and sled speeds
 SLIP_IMPOSED = ("speed_control", "steered")
 #: 40 m/h, the travel velocity of the ESA/ExoMars SWT campaigns.
@@ -24,7 +22,7 @@ class RunCondition:
     multipass: int = 0
     slip_setpoint: float | None = None
     velocity_mps: float = VELOCITY_40_M_PER_H_MPS
-    gravity_mps2: float = STANDARD_GRAVITY_MPS2
+    gravity_mps2: float = G0_MPS2
     steer_deg: float | None = None
     #: photos of the track taken after the run (``/camera/track``), driving slip only
     track_photos: int = 0

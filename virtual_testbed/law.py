@@ -16,9 +16,9 @@ from typing import Protocol
 import numpy as np
 from scipy.optimize import brentq
 
+from swtlab.domain.gravity import G0_MPS2
 from terramechanics import ModelLaw, shipped_model
 
-STANDARD_GRAVITY_MPS2 = 9.80665
 
 
 class PerformanceLaw(Protocol):
@@ -54,12 +54,12 @@ def _root(law: PerformanceLaw, key: str, load_n: float, multipass: int,
 
 
 def self_propelled_slip(law: PerformanceLaw, load_n: float, multipass: int,
-                        gravity_mps2: float = STANDARD_GRAVITY_MPS2) -> float:
+                        gravity_mps2: float = G0_MPS2) -> float:
     """Slip where the law's drawbar pull is zero (a free sled settles there)."""
     return _root(law, "dp_n", load_n, multipass, gravity_mps2)
 
 
 def towed_slip(law: PerformanceLaw, load_n: float, multipass: int,
-               gravity_mps2: float = STANDARD_GRAVITY_MPS2) -> float:
+               gravity_mps2: float = G0_MPS2) -> float:
     """Slip where the law's torque is zero (an unpowered, towed wheel skids there)."""
     return _root(law, "torque_nm", load_n, multipass, gravity_mps2)

@@ -4,19 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from swtlab.domain import Wheel
 
-@dataclass(frozen=True)
-class Wheel:
-    """Wheel geometry as written to ``swt.wheel`` (radius without grousers)."""
-
-    name: str
-    radius_m: float
-    width_m: float
-    grouser_count: int
-    grouser_height_m: float
-    stiffness_n_per_mm: float | None = None
-    mass_kg: float | None = None
-
+__all__ = ["BB2_WHEEL", "Suspension", "Timeline", "Wheel"]
 
 #: ExoMars BB2-like flexible wheel (radius 125 mm without grousers, 12 grousers of 9.2 mm);
 #: its radial stiffness is the one of terramechanics/models/bb2_sand.toml (30 kN/m).

@@ -21,6 +21,8 @@ import cv2
 import numpy as np
 from scipy.ndimage import gaussian_filter1d, maximum_filter1d, uniform_filter1d
 
+from virtual_testbed.rig import BB2_WHEEL
+
 TRUTH_SCHEMA = "swtlab.virtual_testbed.track_render/1"
 _STEP_M = 2e-5  # resolution of the along-track groove profile
 
@@ -174,10 +176,13 @@ def _shade(height_m, albedo, px_per_m, elevation_deg, ambient=0.25):
     return albedo * (ambient + (1 - ambient) * np.clip(lambert, 0, None) * lit)
 
 
-def render_track(slip: float, radius_m: float = 0.125, grouser_count: int = 12,
-                 grouser_height_m: float = 0.0092, px_per_m: float = 1000.0, seed: int = 0,
+def render_track(slip: float, radius_m: float = BB2_WHEEL.radius_m,
+                 grouser_count: int = BB2_WHEEL.grouser_count,
+                 grouser_height_m: float = BB2_WHEEL.grouser_height_m,
+                 px_per_m: float = 1000.0, seed: int = 0,
                  nuisance: TrackNuisance | None = None, **knobs) -> tuple[np.ndarray, dict]:
-    """Grey uint8 photo of the track and its truth (slip, spacing, scale, geometry).
+    """Grey uint8 photo of the track of a wheel (default: the testbed's BB2-like wheel) and
+    its truth (slip, spacing, scale, geometry).
 
     ``knobs`` override fields of ``nuisance`` (default :class:`TrackNuisance`).
     ``px_per_m`` is the ground scale at the image centre (the keystone keeps it there).

@@ -11,6 +11,13 @@ roots of the derivative and added to the grid), the first grid interval that bra
 the target, then safeguarded Newton in it: the smallest slip with ``curve(slip) = target``. A target
 above the curve's maximum gives slip 1.0 and the maximum (status ``above_max``); one below
 its minimum gives slip NaN and the minimum (status ``below_min``).
+
+A curve with a braked branch (``[slip < 0] (J + K slip)``, docs/fitting.md) is two
+polynomials, braked below zero slip and driven from it, which jump at zero by ``-J``. Each
+side gets its own grid (half the points each), the braked one ending at its limit at zero;
+the interval between the
+two sides' values at zero brackets the targets inside the jump, which the wheel gives at zero
+slip: slip 0.0, value the target, status ``at_step`` (counted as reached).
 """
 
 from __future__ import annotations
@@ -25,13 +32,14 @@ GRID_POINTS = 257  # a degree-7 curve turns at most 6 times: ample to bracket ev
 MAX_ITERATIONS = 60  # safeguarded Newton: a few steps; bisection alone needs ~40
 STEP_TOLERANCE = 1e-15
 CHUNK = 4096  # targets per block of the dense search (memory ~ CHUNK x GRID_POINTS)
-STATUS_OK, STATUS_ABOVE, STATUS_BELOW = "ok", "above_max", "below_min"
+STATUS_OK, STATUS_ABOVE, STATUS_BELOW, STATUS_STEP = "ok", "above_max", "below_min", "at_step"
 
 
 @dataclass(frozen=True)
 class SlipSolution:
-    """Per target: ``slip`` (1.0 when above the maximum, NaN below the minimum), ``value`` the
-    curve there (the extreme when unreachable), ``status`` ok / above_max / below_min."""
+    """Per target: ``slip`` (1.0 when above the maximum, NaN below the minimum, 0.0 inside the
+    jump at zero slip), ``value`` the curve there (the extreme when unreachable, the target
+    inside the jump), ``status`` ok / above_max / below_min / at_step."""
 
     slip: np.ndarray
     value: np.ndarray
@@ -39,7 +47,7 @@ class SlipSolution:
 
     @property
     def reached(self) -> np.ndarray:
-        return self.status == STATUS_OK
+        return (self.status == STATUS_OK) | (self.status == STATUS_STEP)
 
 
 def _root(c: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -77,20 +85,38 @@ def _extremes(coefficients: np.ndarray, grid: np.ndarray, values: np.ndarray) ->
     return np.stack(out, axis=1)
 
 
-def solve_slip(coefficients, row, target, slip_min: float, slip_max: float) -> SlipSolution:
+def _side_grids(coefficients: np.ndarray, slip_min: float, slip_max: float,
+                points: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's grid over [slip_min, slip_max] (``points``, ends included) with its extremes
+    added, sorted, and the values there (rows x points)."""
+    base = np.linspace(slip_min, slip_max, points)
+    base_values = horner(coefficients[:, None, :], base)
+    grids = np.sort(np.concatenate([np.broadcast_to(base, (len(coefficients), base.size)),
+                                    _extremes(coefficients, base, base_values)], axis=1), axis=1)
+    return grids, horner(coefficients[:, None, :], grids)
+
+
+def solve_slip(coefficients, row, target, slip_min: float, slip_max: float,
+               below_zero=None) -> SlipSolution:
     """Smallest slip in [slip_min, slip_max] where curve ``row[i]`` (rows of power
-    ``coefficients``) equals ``target[i]``; see the module text for unreachable targets.
+    ``coefficients``, and of braked-branch terms ``below_zero`` (J, K), default none) equals
+    ``target[i]``; see the module text for unreachable targets and the jump at zero slip.
     Raises ``ValueError`` for a non-finite target."""
     coefficients = np.atleast_2d(np.asarray(coefficients, dtype=float))
     row, target = np.asarray(row, dtype=int).ravel(), np.asarray(target, dtype=float).ravel()
     if not np.all(np.isfinite(target)):
         raise ValueError("targets must be finite numbers")
-    base = np.linspace(slip_min, slip_max, GRID_POINTS)
-    base_values = horner(coefficients[:, None, :], base)
-    extreme_slips = _extremes(coefficients, base, base_values)
-    grids = np.sort(np.concatenate([np.broadcast_to(base, (len(coefficients), base.size)),
-                                    extreme_slips], axis=1), axis=1)
-    values = horner(coefficients[:, None, :], grids)
+    braked = coefficients.copy()
+    if below_zero is not None:
+        braked[:, :2] += np.asarray(below_zero, dtype=float)
+    if slip_min < 0 <= slip_max and np.any(braked != coefficients):
+        sides = [(braked, slip_min, 0.0), (coefficients, 0.0, slip_max)]
+    else:  # one polynomial over the range (on one side of zero, or without a branch)
+        sides = [(braked if slip_max < 0 else coefficients, slip_min, slip_max)]
+    points = GRID_POINTS // len(sides) + 1
+    parts = [_side_grids(c, lo, hi, points) for c, lo, hi in sides]
+    grids, values = (np.concatenate(x, axis=1) for x in zip(*parts))
+    n_braked = parts[0][0].shape[1] if len(sides) == 2 else 0  # the jump follows its last point
     top, bottom = values.max(axis=1), values.min(axis=1)
     slip, value = np.full(target.shape, np.nan), np.empty(target.shape)
     status = np.full(target.shape, STATUS_OK, dtype=object)
@@ -105,8 +131,10 @@ def solve_slip(coefficients, row, target, slip_min: float, slip_max: float) -> S
         brackets = (np.sign(d[:, :-1]) != np.sign(d[:, 1:])) | (d[:, :-1] == 0)
         first = np.argmax(brackets, axis=1)
         pick = np.arange(idx.size)
-        shifted = coefficients[r].copy()
+        shifted = np.where((first < n_braked - 1)[:, None], braked[r], sides[-1][0][r])
         shifted[:, 0] -= t
         found = _root(shifted, g[pick, first], g[pick, first + 1])
-        slip[idx], value[idx] = found, horner(coefficients[r], found)
+        slip[idx], value[idx] = found, horner(shifted, found) + t
+        jump = (first == n_braked - 1) & (d[pick, first] * d[pick, first + 1] < 0)  # inside it
+        slip[idx[jump]], value[idx[jump]], status[idx[jump]] = 0.0, t[jump], STATUS_STEP
     return SlipSolution(slip=slip, value=value, status=status.astype(str))

@@ -4,17 +4,21 @@ a :class:`WpmFormatError` naming file, line and problem, never a silently differ
 from __future__ import annotations
 
 import csv
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from fitting.curve import DEGREES, PowerCurve
-from wpm_export.schema import COEFFICIENT_COLUMNS, COLUMNS, FORMAT, UNITS, WpmFormatError
+from swtlab.domain import Wheel
+from wpm_export.schema import (BRANCH_COLUMNS, COEFFICIENT_COLUMNS, COLUMNS, FORMAT, UNITS,
+                               WHEEL_GEOMETRY_KEY, WHEEL_KEYS, WpmFormatError)
 
 
 @dataclass(frozen=True)
 class WpmCurve(PowerCurve):
-    """One row of a WPM CSV: ``sum_i a_i slip**i`` on [slip_min, slip_max]."""
+    """One row of a WPM CSV: ``sum_i a_i slip**i + [slip < 0] (J + K slip)`` on
+    [slip_min, slip_max]."""
 
     soil: str
     wheel: str
@@ -44,11 +48,11 @@ def _integer(text: str, column: str, problem) -> int:
         raise problem(f"{column} {text!r} is not an integer") from None
 
 
-def _curve(fields: list[str], problem, line: int) -> WpmCurve:
-    """One data row -> curve, every rule of the page checked."""
-    if len(fields) != len(COLUMNS):
-        raise problem(f"{len(fields)} fields, the format has {len(COLUMNS)}")
-    row = dict(zip(COLUMNS, (f.strip() for f in fields)))
+def _curve(fields: list[str], problem, line: int, columns: tuple[str, ...]) -> WpmCurve:
+    """One data row -> curve, every rule of the page checked; ``columns``: the file's."""
+    if len(fields) != len(columns):
+        raise problem(f"{len(fields)} fields, the format has {len(columns)}")
+    row = dict(zip(columns, (f.strip() for f in fields)))
     if not row["soil"] or not row["wheel"]:
         raise problem("soil and wheel must not be empty")
     quantity = row["quantity"]
@@ -79,17 +83,48 @@ def _curve(fields: list[str], problem, line: int) -> WpmCurve:
     rmse = _number(row["rmse"], "rmse", problem)
     if rmse < 0:
         raise problem(f"rmse {rmse:g} < 0")
+    step, slope = (_number(row[c], c, problem) if c in row else 0.0 for c in BRANCH_COLUMNS)
     return WpmCurve(coefficients=coefficients, slip_min=slip_min, slip_max=slip_max,
+                    step_below_zero=step, slope_below_zero=slope,
                     soil=row["soil"], wheel=row["wheel"], multipass=multipass, load_n=load_n,
                     quantity=quantity, unit=row["unit"], n_points=n_points, rmse=rmse, line=line)
 
 
+def wheel_geometry(header: dict[str, str], path="<text>", line: int = 0) -> dict[str, Wheel]:
+    """Wheel name -> :class:`swtlab.domain.Wheel` from the header key ``wheel_geometry``
+    (empty for a file without it: older files and other tools' may lack it)."""
+    text = header.get(WHEEL_GEOMETRY_KEY)
+    if text is None:
+        return {}
+    try:
+        table = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY} is not JSON: {exc}") from None
+    if not isinstance(table, dict) or not all(isinstance(v, dict) for v in table.values()):
+        raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY} must map each wheel name to "
+                                         f"its {', '.join(WHEEL_KEYS)}")
+    out = {}
+    for name, values in table.items():
+        missing = [k for k in WHEEL_KEYS if k not in values]
+        unknown = sorted(set(values) - set(WHEEL_KEYS))
+        if missing or unknown:
+            raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY} of wheel {name!r}: "
+                                             f"missing {missing}, unknown {unknown}")
+        try:
+            out[name] = Wheel(name=name, **values)
+        except ValueError as exc:
+            raise WpmFormatError(path, line, f"{WHEEL_GEOMETRY_KEY}: {exc}") from None
+    return out
+
+
 def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCurve]]:
-    """``(header, curves)`` of WPM CSV text; ``header`` maps the comment keys to values."""
+    """``(header, curves)`` of WPM CSV text; ``header`` maps the comment keys to values.
+    The ``wheel_geometry`` header, when there, must give every curve's wheel."""
     header: dict[str, str] = {}
+    lines: dict[str, int] = {}
     curves: list[WpmCurve] = []
     seen: dict[tuple, int] = {}
-    columns_line = 0
+    columns_line, columns = 0, COLUMNS
     for number, raw in enumerate(text.splitlines(), start=1):
         def problem(message: str, _n=number) -> WpmFormatError:
             return WpmFormatError(path, _n, message)
@@ -101,6 +136,7 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
                 if not sep:
                     raise problem("header comment must read '# key: value'")
                 header[key.strip()] = value.strip()
+                lines[key.strip()] = number
                 if len(header) == 1 and key.strip() != "format":
                     raise problem(f"first line must be '# format: {FORMAT}'")
                 continue
@@ -108,11 +144,13 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
                 raise problem(f"missing '# format: {FORMAT}' line before the column header"
                               if "format" not in header else
                               f"format {header['format']!r}, this reader reads {FORMAT!r}")
-            if tuple(f.strip() for f in next(csv.reader([raw]))) != COLUMNS:
-                raise problem(f"column header must be {','.join(COLUMNS)}")
+            columns = tuple(f.strip() for f in next(csv.reader([raw])))
+            if columns not in (COLUMNS + BRANCH_COLUMNS, COLUMNS):
+                raise problem(f"column header must be {','.join(COLUMNS + BRANCH_COLUMNS)} "
+                              f"(or without {', '.join(BRANCH_COLUMNS)})")
             columns_line = number
             continue
-        curve = _curve(next(csv.reader([raw])), problem, number)
+        curve = _curve(next(csv.reader([raw])), problem, number, columns)
         key = (curve.soil, curve.wheel, curve.multipass, curve.load_n, curve.quantity)
         if key in seen:
             raise problem(f"duplicate curve {key} (also line {seen[key]})")
@@ -123,6 +161,11 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
                              f"empty file: no '# format: {FORMAT}' line")
     if not curves:
         raise WpmFormatError(path, columns_line, "no curve rows after the column header")
+    wheels = wheel_geometry(header, path, lines.get(WHEEL_GEOMETRY_KEY, 0))
+    lacking = sorted({c.wheel for c in curves} - set(wheels))
+    if wheels and lacking:
+        raise WpmFormatError(path, lines[WHEEL_GEOMETRY_KEY],
+                             f"{WHEEL_GEOMETRY_KEY} lacks wheel(s) {lacking} of the curves")
     return header, curves
 
 

@@ -13,9 +13,10 @@ import numpy as np
 
 from fitting.errors import OutsideSlipRangeWarning
 from fitting.load_interp import InterpolatedCurve, LoadCurves, interpolate_loads
-from fitting.polynomial import horner
+from fitting.polynomial import curve_value
 from wpm_export.inverse import SlipSolution, solve_slip
-from wpm_export.reader import WpmCurve, read_wpm_csv
+from swtlab.domain import Wheel
+from wpm_export.reader import WpmCurve, read_wpm_csv, wheel_geometry
 from wpm_export.schema import UNITS, WpmSelectionError
 
 CurveSet = tuple[str, str, int]  # (soil, wheel, multipass)
@@ -33,6 +34,7 @@ class WheelPerformanceModule:
     def __init__(self, curves: Iterable[WpmCurve], header: dict[str, str] | None = None,
                  source: str = "<curves>", load_method: str = "auto") -> None:
         self.header, self.source, self.load_method = dict(header or {}), source, load_method
+        self.wheels: dict[str, Wheel] = wheel_geometry(self.header, source)
         self._sets: dict[CurveSet, dict[str, dict[float, WpmCurve]]] = {}
         for c in curves:
             by_quantity = self._sets.setdefault((c.soil, c.wheel, c.multipass), {})
@@ -46,6 +48,24 @@ class WheelPerformanceModule:
 
     def sets(self) -> list[CurveSet]:
         return sorted(self._sets)
+
+    def wheel(self, name: str | None = None, needed_for: str = "this") -> Wheel:
+        """The geometry of wheel ``name`` (needed only when the curves hold several wheels);
+        a one-line error when the file does not carry it (written before the
+        ``wheel_geometry`` header, or by a tool that does not write it)."""
+        names = sorted({w for _, w, _ in self._sets})
+        if name is None:
+            if len(names) != 1:
+                raise WpmSelectionError(f"{self.source}: several wheels {names}; name one")
+            name = names[0]
+        if name not in names:
+            raise WpmSelectionError(f"{self.source}: no curves of wheel {name!r}; wheels: {names}")
+        if name not in self.wheels:
+            raise WpmSelectionError(
+                f"{self.source}: no wheel geometry (header '# wheel_geometry:'), and {needed_for} "
+                f"needs wheel {name!r}'s radius, width and grousers; export the WPM CSV again "
+                "with this swtlab, or add the header (docs/wpm-csv.md)")
+        return self.wheels[name]
 
     def select(self, soil: str | None = None, wheel: str | None = None,
                multipass: int | None = None) -> CurveSet:
@@ -102,7 +122,9 @@ class WheelPerformanceModule:
             curves, index = self._curves_at(q, load, selection, allow_extrapolation)
             if np.any((slip < curves.slip_min) | (slip > curves.slip_max)):
                 outside.append(f"{q} [{curves.slip_min:g}, {curves.slip_max:g}]")
-            out[q] = horner(curves.coefficients[index], slip.ravel()).reshape(slip.shape)
+            step, slope = curves.below_zero[index].T if curves.below_zero.any() else (0.0, 0.0)
+            out[q] = curve_value(curves.coefficients[index], slip.ravel(), step,
+                                 slope).reshape(slip.shape)
         if outside:
             warnings.warn("slip outside the range of " + ", ".join(outside) + ": extrapolated",
                           OutsideSlipRangeWarning, stacklevel=2)
@@ -111,14 +133,15 @@ class WheelPerformanceModule:
     def slip_for(self, quantity: str, target, load_n, *, soil=None, wheel=None, multipass=None,
                  allow_extrapolation: bool = False) -> SlipSolution:
         """The smallest slip at which the wheel gives ``target`` of ``quantity`` at ``load_n``
-        (broadcast together); slip 1.0 and the maximum where the target is above the curve
+        (broadcast together); slip 1.0 and the maximum where the target is above the curve,
+        slip 0.0 and status ``at_step`` where it falls inside the jump at zero slip
         (:mod:`wpm_export.inverse`)."""
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
         target, load = np.broadcast_arrays(np.asarray(target, dtype=float),
                                            np.asarray(load_n, dtype=float))
         curves, index = self._curves_at(quantity, load, selection, allow_extrapolation)
         found = solve_slip(curves.coefficients, index, target.ravel(), curves.slip_min,
-                           curves.slip_max)
+                           curves.slip_max, curves.below_zero)
         shape = target.shape
         return SlipSolution(slip=found.slip.reshape(shape), value=found.value.reshape(shape),
                             status=found.status.reshape(shape))

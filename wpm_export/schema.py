@@ -9,7 +9,13 @@ MAX_DEGREE = max(DEGREES)
 COEFFICIENT_COLUMNS = tuple(f"a{i}" for i in range(MAX_DEGREE + 1))
 COLUMNS = (("soil", "wheel", "multipass", "load_n", "quantity", "unit", "degree", "slip_min",
             "slip_max") + COEFFICIENT_COLUMNS + ("n_points", "rmse"))
+#: the braked branch ``[slip < 0] (J + K slip)`` (docs/fitting.md), written after the others;
+#: a file without them (older swtlab, other tools) reads as J = K = 0
+BRANCH_COLUMNS = ("step_below_zero", "slope_below_zero")
 UNITS = QUANTITY_UNITS  # dp_n N, torque_nm N*m, sinkage_m m, resistance_n N, dp_over_w 1
+#: header key of the wheels' geometry (JSON: name -> WHEEL_KEYS)
+WHEEL_GEOMETRY_KEY = "wheel_geometry"
+WHEEL_KEYS = ("radius_m", "width_m", "grouser_count", "grouser_height_m", "stiffness_n_per_mm")
 
 
 class WpmFormatError(ValueError):

@@ -5,6 +5,9 @@ from __future__ import annotations
 import csv
 import hashlib
 import io
+import json
+import os
+import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -13,7 +16,9 @@ import pandas as pd
 from fitting.curve import CurveFit
 from fitting.table import KEY_COLUMNS, MEASURED
 from wpm_export.reader import parse_wpm_csv
-from wpm_export.schema import COLUMNS, FORMAT, MAX_DEGREE, UNITS
+from swtlab.domain import Wheel
+from wpm_export.schema import (BRANCH_COLUMNS, COLUMNS, FORMAT, MAX_DEGREE, UNITS,
+                               WHEEL_GEOMETRY_KEY, WHEEL_KEYS)
 
 #: the columns of a results table the fits read, in the order they are hashed
 HASHED_COLUMNS = (KEY_COLUMNS + ("slip", "slip_se", "wheel_load_n", "wheel_load_n_se")
@@ -52,14 +57,25 @@ def _row(fit: CurveFit) -> list[str]:
     return [fit.soil, fit.wheel, str(int(fit.multipass)), repr(float(fit.load_n)), fit.quantity,
             UNITS[fit.quantity], str(fit.degree), repr(float(fit.slip_min)),
             repr(float(fit.slip_max)), *coefficients, *[""] * (MAX_DEGREE + 1 - len(coefficients)),
-            str(int(fit.n_points)), repr(float(fit.rmse))]
+            str(int(fit.n_points)), repr(float(fit.rmse)),
+            repr(float(fit.step_below_zero)), repr(float(fit.slope_below_zero))]
+
+
+def _geometry(wheels: dict[str, Wheel], names: set[str]) -> str:
+    lacking = sorted(names - set(wheels))
+    if lacking:
+        raise ValueError(f"no geometry for wheel(s) {lacking}: the WPM CSV carries each "
+                         "curve's wheel (radius, width, grousers, stiffness)")
+    return json.dumps({name: {k: getattr(wheels[name], k) for k in WHEEL_KEYS}
+                       for name in sorted(names)}, separators=(", ", ": "))
 
 
 def wpm_csv_text(fits: Iterable[CurveFit], inputs_sha256: str, swtlab_version: str,
-                 created: str | None = None) -> str:
+                 created: str | None = None, wheels: dict[str, Wheel] | None = None) -> str:
     """The WPM CSV as text: header comments, column row, one row per curve sorted by
-    (soil, wheel, multipass, load_n, quantity in the format's order). The text is read back
-    before it is returned, so nothing the reader would refuse is ever written."""
+    (soil, wheel, multipass, load_n, quantity in the format's order). ``wheels`` (name ->
+    geometry) must hold every curve's wheel. The text is read back before it is returned, so
+    nothing the reader would refuse is ever written."""
     order = {q: i for i, q in enumerate(UNITS)}
     rows = sorted(fits, key=lambda f: (f.soil, f.wheel, f.multipass, f.load_n, order[f.quantity]))
     out = io.StringIO()
@@ -67,16 +83,28 @@ def wpm_csv_text(fits: Iterable[CurveFit], inputs_sha256: str, swtlab_version: s
               f"# inputs_sha256: {inputs_sha256}\n")
     if created:
         out.write(f"# created: {created}\n")
+    if wheels is not None:
+        out.write(f"# {WHEEL_GEOMETRY_KEY}: {_geometry(wheels, {f.wheel for f in rows})}\n")
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(COLUMNS)
+    writer.writerow(COLUMNS + BRANCH_COLUMNS)
     writer.writerows(_row(f) for f in rows)
     parse_wpm_csv(out.getvalue(), "<WPM CSV being written>")
     return out.getvalue()
 
 
 def write_wpm_csv(fits: Iterable[CurveFit], path, inputs_sha256: str, swtlab_version: str,
-                  created: str | None = None) -> str:
-    """Write the WPM CSV to ``path`` (UTF-8, ``\\n`` line ends); return the file's sha256."""
-    data = wpm_csv_text(fits, inputs_sha256, swtlab_version, created).encode("utf-8")
-    Path(path).write_bytes(data)
+                  created: str | None = None, wheels: dict[str, Wheel] | None = None) -> str:
+    """Write the WPM CSV to ``path`` (UTF-8, ``\\n`` line ends) atomically (a temporary file
+    beside it, then ``os.replace``); return the file's sha256."""
+    data = wpm_csv_text(fits, inputs_sha256, swtlab_version, created, wheels).encode("utf-8")
+    path = Path(path)
+    handle, temp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        os.fchmod(handle, 0o644)
+        with os.fdopen(handle, "wb") as out:
+            out.write(data)
+        os.replace(temp, path)
+    except BaseException:
+        Path(temp).unlink(missing_ok=True)
+        raise
     return hashlib.sha256(data).hexdigest()

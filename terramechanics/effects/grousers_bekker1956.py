@@ -9,7 +9,7 @@ sides carry the full cohesion but only part of the normal stress::
     F = b l c (1 + 2h/b) + W tan(phi) (1 + 0.64 (h/b) arccot(h/b))
 
 Here the shear acts on the radius ``r_s = r + lambda h`` (lambda = 1: the tip surface
-of Bekker's picture; Ding, Gao, Deng & Tao 2011, J. Terramech. 48(1):27-45, fit
+of Bekker's picture; Ding et al. 2011, J. Terramech. 48(1):27-45, fit
 0 <= lambda <= 1 per wheel), and the two factors multiply ``c`` and ``tan phi`` of the
 contact's shear strength (the bulldozing laws then see the same strengthened soil).
 The grouser faces add nothing else: their push on the trapped soil is what this shear

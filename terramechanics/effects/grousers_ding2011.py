@@ -1,6 +1,6 @@
 """Lugs after Ding et al.: equivalent shear radius and lug-induced slip-sinkage.
 
-Ding, Gao, Deng & Tao (2011) "Experimental study and analysis on driving wheels'
+Ding, Gao, Deng, Nagatani & Yoshida (2011) "Experimental study and analysis on driving wheels'
 performance for planetary exploration rovers moving in deformable soil", J.
 Terramechanics 48(1):27-45, and Ding et al. (2015), J. Field Robotics 32(6): the lugs
 move the shear surface to the equivalent radius ``r_s = r + lambda h`` (0 <= lambda

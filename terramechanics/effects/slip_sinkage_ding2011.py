@@ -1,6 +1,6 @@
 """Slip-sinkage after Ding et al.: the sinkage exponent grows with slip, ``n = n0 + n1 |s|``.
 
-Ding, Gao, Deng & Tao (2011) "Experimental study and analysis on driving wheels'
+Ding, Gao, Deng, Nagatani & Yoshida (2011) "Experimental study and analysis on driving wheels'
 performance for planetary exploration rovers moving in deformable soil",
 J. Terramechanics 48(1):27-45; Ding et al. (2015) "Interaction mechanics model for
 rigid driving wheels of planetary rovers moving on sandy terrain with consideration

@@ -1,0 +1,66 @@
+"""Can the campaign identify a candidate's free parameters? A fit of k parameters to a
+handful of points always finds values, and a held-out score on so few points cannot tell a
+real fit from an over-fit; such a call must be ``inconclusive``, never a confident ``[]``.
+
+Two checks on the chosen candidate's full-data fit: (1) at least
+:data:`MIN_POINTS_PER_PARAM` measured points (conditions; the quantities of one point share
+its condition) per free parameter; (2) the Jacobian of the standardised residuals with
+respect to the parameters, each column scaled by its parameter's fitted range (bounds,
+log for log parameters), has full numerical rank: singular values above
+:data:`RANK_RTOL` times the largest (a direction of the parameters the points do not
+constrain makes the Fisher information ``J^T J`` singular; Rothenberg 1971, Econometrica
+39(3):577-591, "Identification in parametric models")."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from sim_gap.fit import FitResult, quantities_of, standardised_residuals, to_internal, to_values
+from sim_gap.simulated import Simulated
+
+#: fewest measured points per free parameter for a confident call
+MIN_POINTS_PER_PARAM = 3.0
+#: a scaled singular value below this fraction of the largest is an unconstrained direction
+RANK_RTOL = 1e-4
+#: central-difference step, as a fraction of each parameter's (internal) range
+STEP_FRACTION = 1e-3
+
+
+def jacobian(sim: Simulated, fit: FitResult, points: pd.DataFrame,
+             sigma: dict[str, np.ndarray]) -> np.ndarray:
+    """d(standardised residual)/d(parameter / its internal range) at the fit, by central
+    differences; rows: the measured residuals."""
+    c = fit.candidate
+    span = np.array([np.log(p.upper / p.lower) if p.log else p.upper - p.lower
+                     for p in c.params])
+    u = to_internal(c, fit.values)
+    measured = np.isfinite(points[quantities_of(points)].to_numpy(float))
+
+    def r(x):
+        pred = sim.predict(points, to_values(c, x))
+        return standardised_residuals(points, pred, sigma, np.inf)[measured]
+
+    cols = []
+    for i, h in enumerate(STEP_FRACTION * span):
+        du = np.zeros_like(u)
+        du[i] = h
+        cols.append((r(u + du) - r(u - du)) / (2 * STEP_FRACTION))
+    return np.column_stack(cols)
+
+
+def identification_problem(sim: Simulated, fit: FitResult, points: pd.DataFrame,
+                           sigma: dict[str, np.ndarray]) -> str | None:
+    """Why ``points`` cannot identify ``fit``'s parameters (one sentence), or None."""
+    n, k, label = len(points), fit.n_params, fit.candidate.label
+    if n < MIN_POINTS_PER_PARAM * k:
+        return (f"{n} measured points cannot identify the {k} free parameters of {label} "
+                f"(fewer than {MIN_POINTS_PER_PARAM:g} points per parameter): neither an "
+                "effect nor its absence can be called")
+    s = np.linalg.svd(jacobian(sim, fit, points, sigma), compute_uv=False)
+    rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+    if rank < k:
+        return (f"the points fix only {rank} of the {k} free parameters of {label} (the "
+                "Jacobian of the residuals is rank-deficient): neither an effect nor its "
+                "absence can be called")
+    return None

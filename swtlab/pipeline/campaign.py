@@ -1,0 +1,69 @@
+"""What the pipeline carries: a processed run, a failure, a campaign."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from swtlab.domain import Wheel, check_results, wheels_of
+
+
+@dataclass(frozen=True)
+class Failure:
+    """A run (or part of one) that could not be processed: the ``file``, the ``stage``
+    (``ingest``, ``results``, ``soil_flow``) and the one-line ``reason``."""
+
+    file: str
+    stage: str
+    reason: str
+
+
+@dataclass
+class ProcessedRun:
+    """One raw file through the pipeline. ``run``: the ``ingest.Run`` (None when it could not
+    be read, or when the campaign was loaded from a database); ``result``: its
+    ``run_results.RunResult``; ``flow``: its soil flow (``softflow.flow_run.RunFlow``) with
+    ``flow_npz``, the packed arrays the database keeps; ``failures`` of any stage."""
+
+    path: Path
+    sha256: str
+    run: Any = None
+    streams: list | None = None
+    result: Any = None
+    flow: Any = None
+    flow_npz: bytes | None = None
+    failures: list[Failure] = field(default_factory=list)
+
+    @property
+    def run_id(self) -> str | None:
+        return None if self.result is None else self.result.run_id
+
+
+@dataclass
+class Campaign:
+    """A processed campaign: ``runs`` (:class:`ProcessedRun`), ``results`` (one row per run in
+    the schema of :mod:`swtlab.domain.results`, docs/results.md), ``failures`` (every run or
+    part of one that failed, with file, stage and reason), the processing ``parameters`` and
+    the ``source`` database URL of a campaign loaded from one."""
+
+    runs: list[ProcessedRun]
+    results: pd.DataFrame
+    failures: list[Failure]
+    parameters: dict = field(default_factory=dict)
+    source: str | None = None
+
+    def __post_init__(self) -> None:
+        check_results(self.results)
+
+    @property
+    def wheels(self) -> dict[str, Wheel]:
+        """Wheel name -> geometry, from the results."""
+        return wheels_of(self.results) if len(self.results) else {}
+
+    @property
+    def names(self) -> list[str]:
+        """The campaign names (``swt.run.campaign``) the results hold."""
+        return sorted(set(self.results["campaign"])) if len(self.results) else []

@@ -1,0 +1,106 @@
+"""Measured against simulated: ``diagnose_gap`` -> :class:`GapReport` (docs/gap-report.md)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from swtlab.pipeline.campaign import Campaign
+
+
+@dataclass
+class GapReport:
+    """The gap report (``data``: the JSON of docs/gap-report.md) with its main answers."""
+
+    data: dict
+
+    @property
+    def verdict(self) -> list[str] | str:
+        """The missing effects found, ``[]`` for none, or ``"inconclusive"``."""
+        return self.data["verdict"]
+
+    @property
+    def reason(self) -> str:
+        return self.data["reason"]
+
+    @property
+    def shrink_pct(self) -> dict[str, float]:
+        """Held-out RMSE shrink per quantity, %, with the chosen explanation."""
+        return self.data["shrink_pct"]
+
+    def regions(self) -> pd.DataFrame:
+        """The residual map, one row per region and quantity."""
+        return pd.DataFrame(self.data["regions"])
+
+    def to_dict(self) -> dict:
+        return self.data
+
+    def write(self, json_path: str | Path | None = None,
+              html_path: str | Path | None = None) -> None:
+        """Write the JSON and the self-contained HTML page (the campaign report's gap
+        section on a page of its own) where asked."""
+        from campaign_report.gap import write_gap_page
+        from sim_gap.report import write_json
+
+        if json_path:
+            write_json(self.data, json_path)
+        if html_path:
+            write_gap_page(self.data, html_path)
+
+
+def _points(measured) -> tuple[pd.DataFrame, str]:
+    from sim_gap.measured import combine, from_results_table, load_measured
+
+    if isinstance(measured, (list, tuple)):
+        if not measured:
+            raise ValueError("no measured source given")
+        parts = [_points(m) for m in measured]
+        return combine([p for p, _ in parts]), " + ".join(label for _, label in parts)
+    if isinstance(measured, Campaign):
+        label = "campaign " + ", ".join(measured.names)
+        return from_results_table(measured.results, source=label), label
+    if isinstance(measured, pd.DataFrame):
+        return from_results_table(measured, source="results table"), "results table"
+    return load_measured(str(measured)), str(measured)
+
+
+def _simulated(simulation, reference_model):
+    import terramechanics as tm
+    from sim_gap.simulated import Simulated, load_simulated
+
+    if isinstance(simulation, Simulated):
+        return simulation, simulation.source
+    if isinstance(simulation, tm.WheelModel):
+        return Simulated(simulation), "<model>"
+    return load_simulated(simulation, reference_model), str(simulation)
+
+
+def diagnose_gap(measured, simulation, *, effects: list[str] | None = None,
+                 reference_model: str | Path | None = None, n_boot: int = 200, jobs: int = 1,
+                 seed: int = 0, laws: dict[str, tuple[str, ...]] | None = None,
+                 allow_wheel_mismatch: bool = False) -> GapReport:
+    """Where the measurements and the simulation differ, which missing effect explains it and
+    how far (docs/gap-report.md).
+
+    ``measured``: a :class:`Campaign`, a results table (docs/results.md), a database URL, a
+    WPM CSV, a points CSV (docs/points-csv.md) or a CMU ``smooth_runs.csv``, or a list of
+    them (several sources on one soil: the soil is fitted on all, each source keeps its
+    wheel; docs/gap-report.md, "Several sources"); ``simulation``: a model TOML, a
+    ``terramechanics.WheelModel`` or a simulator's WPM CSV (with ``reference_model``
+    computing the effect corrections). The measured wheel must be the simulated one (radius,
+    width, grousers), else ``sim_gap.wheel_check.WheelMismatchError``, unless
+    ``allow_wheel_mismatch``; sources of several wheels are each simulated with their own.
+    ``n_boot`` bootstrap replicates, ``jobs`` worker processes; ``laws``: effect -> the laws
+    its candidates may use (default: every law of the family; a verdict must hold under each,
+    docs/gap-report.md, "Laws").
+    """
+    from sim_gap.api import gap_report
+    from sim_gap.diagnose import Settings
+
+    points, measured_label = _points(measured)
+    sim, sim_label = _simulated(simulation, reference_model)
+    return GapReport(gap_report(points, sim, measured_label, sim_label, effects,
+                                Settings(n_boot=n_boot, jobs=jobs, seed=seed, laws=laws),
+                                allow_wheel_mismatch))

@@ -1,0 +1,177 @@
+"""Raw files -> per-run results: ``process_file`` (one run, the function every worker runs)
+and ``process_campaign`` (a folder, serially or on a process pool). No database."""
+
+from __future__ import annotations
+
+import tomllib
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
+
+#: the campaign's settings file (``[rig_compliance]``, docs/run-results.md)
+CAMPAIGN_SETTINGS = "swtlab.toml"
+
+
+@dataclass(frozen=True)
+class ProcessSettings:
+    """How runs are processed: channel map, rig compliance (``run_results.RigCompliance`` or
+    None), stable-phase parameters, side-camera frames per flow (0: no soil flow)."""
+
+    channel_map: str | None = None
+    rig: object = None
+    stable: object = None
+    max_frames: int | None = None
+
+    def __post_init__(self) -> None:
+        from softflow.flow_run import MAX_FRAMES
+        from stable_phase import StablePhaseParams
+
+        if self.stable is None:
+            object.__setattr__(self, "stable", StablePhaseParams())
+        if self.max_frames is None:
+            object.__setattr__(self, "max_frames", MAX_FRAMES)
+
+    def parameters(self) -> dict:
+        """The parameters recorded with (and hashed into) every stored result."""
+        return {"stable_phase": self.stable.to_dict(), "channel_map": self.channel_map,
+                "rig_compliance": self.rig.to_dict() if self.rig else None,
+                "flow": {"max_frames": self.max_frames}}
+
+
+def rig_compliance(folder: Path, path: Path | None = None):
+    """The ``[rig_compliance]`` of ``path``, else of ``folder/swtlab.toml``; None when neither
+    file exists. A named file that is missing, or a file without the table, is an error."""
+    from run_results import RigCompliance
+
+    source = Path(path) if path else Path(folder) / CAMPAIGN_SETTINGS
+    if not source.is_file():
+        if path:
+            raise FileNotFoundError(f"{source}: no such file")
+        return None
+    table = tomllib.loads(source.read_text()).get("rig_compliance")
+    if table is None:
+        raise ValueError(f"{source}: no [rig_compliance] table")
+    return RigCompliance.from_dict(table)
+
+
+def _soil_flow(done: ProcessedRun, settings: ProcessSettings) -> None:
+    from softflow.flow_archive import pack_flow
+    from softflow.flow_run import FlowRunError, run_flow
+
+    window = done.result.window
+    if not window.found or settings.max_frames <= 0:
+        return
+    try:
+        flow = run_flow(done.run, window.start_s, window.end_s, settings.max_frames)
+    except FlowRunError as error:
+        done.failures.append(Failure(str(done.path), "soil_flow", error.problem))
+        return
+    except Exception as error:  # noqa: BLE001 - one run's camera must not stop the batch
+        done.failures.append(Failure(str(done.path), "soil_flow", "internal error in the flow "
+                                     f"analysis ({type(error).__name__}: {error})"))
+        return
+    if flow is not None:
+        done.flow, done.flow_npz = flow, pack_flow(flow.result, flow.first_frame)
+
+
+def process_file(path: Path, settings: ProcessSettings) -> ProcessedRun:
+    """Read one raw file, find its stable phase, compute its results and its soil flow. Never
+    raises for a bad run: what failed is in ``failures`` (ingest: nothing else is done)."""
+    import ingest
+    from ingest.inspect_report import report
+    from run_results import process_run
+    from softflow.track_run import run_image_slip
+    from traceability.hashing import content_sha256
+
+    path = Path(path)
+    done = ProcessedRun(path=path, sha256=content_sha256(path)[0])
+    try:
+        done.run = ingest.read_run(path, channel_map=settings.channel_map)
+        done.streams = report(done.run)["streams"]
+    except ingest.IngestError as error:
+        done.run = None
+        done.failures.append(Failure(str(path), "ingest", str(error)))
+        return done
+    except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
+        done.run = None
+        done.failures.append(Failure(str(path), "ingest",
+                                     f"internal error ({type(error).__name__}: {error})"))
+        return done
+    try:
+        done.result = process_run(done.run, settings.stable, settings.rig,
+                                  run_image_slip(done.run))
+    except Exception as error:  # noqa: BLE001
+        done.failures.append(Failure(str(path), "results",
+                                     f"internal error ({type(error).__name__}: {error})"))
+        return done
+    _soil_flow(done, settings)
+    return done
+
+
+def _process(args: tuple[Path, ProcessSettings]) -> ProcessedRun:
+    return process_file(*args)
+
+
+def campaign_of(runs: list[ProcessedRun], parameters: dict) -> Campaign:
+    """The :class:`Campaign` of processed runs (results table of the runs with a result)."""
+    from run_results import results_table
+
+    table = results_table([r.result for r in runs if r.result is not None])
+    sources = {r.result.run_id: r for r in runs if r.result is not None}
+    if len(table):
+        table.insert(2, "raw_file_path", [str(sources[i].path.resolve()) for i in table["run_id"]])
+        table.insert(3, "raw_file_sha256", [sources[i].sha256 for i in table["run_id"]])
+    return Campaign(runs=runs, results=table,
+                    failures=[f for r in runs for f in r.failures], parameters=parameters)
+
+
+def find_runs(folder: str | Path, channel_map: str | None = None) -> list[Path]:
+    """The run files under ``folder``; a one-line error when there is none."""
+    import ingest
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise FileNotFoundError(f"{folder}: no such folder")
+    paths = ingest.find_runs(folder, channel_map=channel_map)
+    if not paths:
+        raise ValueError(f"{folder}: no runs found (MCAP files or folders with run.json; "
+                         "channel_map for other files)")
+    return paths
+
+
+def _name(path: Path) -> str:
+    return path.stem if path.is_file() else path.name
+
+
+def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: int = 1, *,
+                     rig_compliance_file: str | Path | None = None,
+                     runs: list[str] | None = None, soil_flow: bool = True,
+                     progress=None) -> Campaign:
+    """Every run under ``folder`` -> :class:`Campaign`, without a database.
+
+    ``channel_map``: TOML map (path or shipped name) for a lab's own files; ``jobs`` > 1 runs
+    :func:`process_file` on that many worker processes; ``rig_compliance_file``: overrides
+    ``folder/swtlab.toml``; ``runs``: only the files whose name (without suffix) is listed;
+    ``soil_flow=False`` skips the side-camera analysis; ``progress``: wraps the file list
+    (e.g. ``tqdm``). A run that fails is in ``.failures`` and the batch goes on.
+    """
+    if jobs < 1:
+        raise ValueError(f"jobs {jobs} must be >= 1")
+    paths = find_runs(folder, channel_map)
+    if runs is not None:
+        unknown = sorted(set(runs) - {_name(p) for p in paths})
+        if unknown:
+            raise ValueError(f"{folder}: no run file(s) {unknown}")
+        paths = [p for p in paths if _name(p) in set(runs)]
+    settings = ProcessSettings(channel_map=channel_map,
+                               rig=rig_compliance(Path(folder), rig_compliance_file),
+                               max_frames=None if soil_flow else 0)
+    work = [(p, settings) for p in paths]
+    if jobs > 1:
+        with ProcessPoolExecutor(min(jobs, len(work))) as pool:
+            done = list(pool.map(_process, work))
+    else:
+        done = [_process(w) for w in (progress(work) if progress else work)]
+    return campaign_of(done, settings.parameters())

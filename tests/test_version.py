@@ -1,0 +1,16 @@
+"""The version comes from one place (pyproject.toml) and each one has its CHANGELOG entry."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import re
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_installed_version_is_pyprojects_and_the_newest_changelog_entry():
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    newest = re.search(r"^## (\S+)", (ROOT / "CHANGELOG.md").read_text(), re.M).group(1)
+    assert importlib.metadata.version("swtlab") == declared == newest
