@@ -26,11 +26,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fast", action="store_true",
                    help="small campaigns (2 loads x 3 slips x 2 multipass x 2 gravity)")
     p.add_argument("--json", type=Path, help="write the score JSON here")
+    p.add_argument("--signal-model", choices=("testbed", "second"), default="testbed",
+                   help="raw runs from the virtual testbed or the second rig (docs/second-rig.md)")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from validation.gap_bench import FAST_DESIGN, Design, format_score, run_bench
+    from validation.gap_bench_second import run_bench_second
 
     if args.n < 1:
         print("swtlab gap-bench: --n must be >= 1")
@@ -38,7 +41,8 @@ def run(args: argparse.Namespace) -> int:
     design = FAST_DESIGN if args.fast else Design()
     with tempfile.TemporaryDirectory(prefix="gap-bench-") as tmp:
         workdir = args.workdir or Path(tmp)
-        result = run_bench(args.n, args.seed, workdir, design, args.jobs, args.boot)
+        bench = run_bench if args.signal_model == "testbed" else run_bench_second
+        result = bench(args.n, args.seed, workdir, design, args.jobs, args.boot)
     print(format_score(result))
     t = result["timing_s"]
     print(f"time: generate {t['generate']:.0f} s, process + diagnose "
