@@ -11,7 +11,6 @@ so a campaign differs from a gap_bench one only in its signals.
 
 from __future__ import annotations
 
-import json
 import shutil
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
@@ -24,6 +23,7 @@ from validation.gap_bench import (Design, base_model, conditions, diagnose_campa
                                   score)
 from validation.model_truth import ModelTruth
 from validation.second_rig import Rig, RunCondition, Timeline, WheelGeometry, write_campaign
+from validation.second_rig.writers import write_json
 
 DEFAULT_DESIGN = Design()
 
@@ -65,9 +65,7 @@ def make_campaigns_second(n: int, seed: int, workdir: Path, design: Design = DEF
     with ProcessPoolExecutor(jobs) as pool:
         list(pool.map(_generate, work))
     labels = {f"c{i:03d}": label for i, (_, label) in enumerate(truths)}
-    path = workdir / "labels" / "labels.json"
-    path.write_text(json.dumps(labels, indent=1) + "\n")
-    return path
+    return write_json(workdir / "labels" / "labels.json", labels, workdir / "labels")
 
 
 def run_bench_second(n: int, seed: int, workdir: Path, design: Design = DEFAULT_DESIGN,
@@ -84,5 +82,5 @@ def run_bench_second(n: int, seed: int, workdir: Path, design: Design = DEFAULT_
     out["timing_s"] = {"generate": t1 - t0, "process_and_diagnose": t2 - t1,
                        "per_campaign_mean": float(np.mean(seconds)), "jobs": jobs}
     out["signal_model"] = "second_rig"
-    (workdir / "score.json").write_text(json.dumps(out, indent=1) + "\n")
+    write_json(workdir / "score.json", out, workdir)
     return out
