@@ -28,8 +28,9 @@ from validation.second_rig.writers import write_json
 DEFAULT_DESIGN = Design()
 
 
-def rig_conditions(design: Design, campaign: str) -> list[RunCondition]:
-    """gap_bench's conditions as second-rig conditions, on the virtual testbed's wheel."""
+def rig_conditions(conds, campaign: str) -> list[RunCondition]:
+    """Speed-control conditions of the virtual testbed (gap_bench's ``conditions``) as
+    second-rig conditions, on the virtual testbed's wheel."""
     from virtual_testbed.rig import BB2_WHEEL
 
     w = BB2_WHEEL
@@ -39,15 +40,22 @@ def rig_conditions(design: Design, campaign: str) -> list[RunCondition]:
     return [RunCondition(c.run_id, c.mode, c.load_n, c.slip_setpoint, multipass=c.multipass,
                          gravity_mps2=c.gravity_mps2, velocity_mps=c.velocity_mps, soil="sand",
                          campaign=campaign, wheel=wheel)
-            for c in conditions(design)]
+            for c in conds]
+
+
+def write_second_campaign(out: Path, conds, truth: tm.WheelModel, seed: int, name: str,
+                          duration_s: float) -> None:
+    """One campaign's raw runs from the second rig under ``out/campaign``, the truth of
+    ``truth``'s curves under ``out/truth`` (as the testbed's ``generate_campaign``)."""
+    rig = Rig(timeline=Timeline(duration_s=duration_s))
+    write_campaign(out, rig_conditions(conds, name), ModelTruth(truth), seed, rig=rig)
 
 
 def _generate(job) -> None:
-    """One campaign's raw runs from the second rig; its truth folder is moved out of it."""
+    """One campaign; its truth folder is moved out of it."""
     workdir, name, truth, seed, design = job
     out = workdir / name
-    rig = Rig(timeline=Timeline(duration_s=design.duration_s))
-    write_campaign(out, rig_conditions(design, name), ModelTruth(truth), seed, rig=rig)
+    write_second_campaign(out, conditions(design), truth, seed, name, design.duration_s)
     (workdir / "labels" / name).mkdir(parents=True, exist_ok=True)
     shutil.move(str(out / "truth"), str(workdir / "labels" / name / "truth"))
 
