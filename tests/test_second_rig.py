@@ -25,7 +25,7 @@ from mcap.reader import make_reader
 import ingest
 from validation.second_rig import (Rig, RunCondition, SecondRigError, SensorModel,
                                    WheelGeometry, write_campaign)
-from validation.second_rig.sensors import drift, pink_noise
+from validation.second_rig.sensors import drift, pink_noise, sample_clock
 from validation.second_rig.signals import ar1, fin_wave, step_response
 
 QUIET = SensorModel(force_ar_sd_n=0, force_pink_sd_n=0, torque_ar_sd_nm=0, torque_pink_sd_nm=0,
@@ -84,6 +84,15 @@ def test_coloured_noise_and_drift_follow_their_definitions():
     assert ends[:, 1].var() == pytest.approx(0.05**2 * 100, rel=0.1)
     assert drift(t, 60.0, 0.0, 0.01, rng).tolist() == pytest.approx([0.6, 1.0])
 
+
+
+def test_clock_never_logs_a_sample_before_the_logger_starts():
+    # jitter clipped at 0.3 of a period: without the floor at 0 the first sample falls
+    # before 0 whenever the phase is smaller than its jitter (an MCAP log time is unsigned)
+    sensor = SensorModel(clock_jitter_s=1.0, dropped_fraction=0.0)
+    rng = np.random.default_rng(2)
+    firsts = [sample_clock(120.0, 2.0, sensor, rng)[1][0] for _ in range(200)]
+    assert min(firsts) == 0 and sum(f == 0 for f in firsts) > 20
 
 @pytest.fixture(scope="module")
 def two_forms(tmp_path_factory):

@@ -22,7 +22,8 @@ effects, which would give them away), and the diagnosis gets the remaining laws.
 
 Signal models (``signal_model``): ``testbed`` (``virtual_testbed``) or ``second``
 (``validation.second_rig``, written apart from the testbed: other transients, noise,
-drift), through :func:`write_second_rig`.
+drift; the testbed's BB2 wheel with its stiffness, the design's run length), through
+``validation.gap_bench_second.write_second_campaign``.
 """
 
 from __future__ import annotations
@@ -142,34 +143,6 @@ def conditions(design: Design):
     return out
 
 
-def write_second_rig(out: Path, conds, truth: tm.WheelModel, seed: int, name: str) -> None:
-    """The hook to the second signal model: ``validation.second_rig.write_campaign`` with
-    the bench's conditions and the truth model as its truth function (its raw runs under
-    ``out/campaign``, its truth under ``out/truth``, like the testbed's)."""
-    try:
-        from validation import second_rig
-    except ImportError as exc:
-        raise ValueError("signal model 'second' needs validation.second_rig "
-                         "(branch second)") from exc
-    w = truth.wheel
-    wheel = second_rig.WheelGeometry(name="bench_wheel", radius_m=w.radius_m,
-                                     width_m=w.width_m, grouser_count=w.grouser_count,
-                                     grouser_height_m=w.grouser_height_m)
-    runs = [second_rig.RunCondition(c.run_id, "speed_control", c.load_n,
-                                    slip_setpoint=c.slip_setpoint, multipass=c.multipass,
-                                    gravity_mps2=c.gravity_mps2, campaign=name, wheel=wheel)
-            for c in conds]
-    law = tm.ModelLaw(truth)
-
-    def truth_fn(c) -> dict[str, float]:
-        v = law.evaluate(c.load_n, c.slip_setpoint, c.multipass, c.gravity_mps2)
-        return {"slip": c.slip_setpoint, "travel_velocity_mps": c.velocity_mps,
-                "wheel_load_n": c.load_n, **{q: float(v[q]) for q in
-                                             ("dp_n", "torque_nm", "sinkage_m")}}
-
-    second_rig.write_campaign(out, runs, truth_fn, seed)
-
-
 def _generate(job) -> None:
     """One campaign's raw runs; its truth folder is moved out of the campaign."""
     from virtual_testbed import Testbed, generate_campaign
@@ -177,7 +150,9 @@ def _generate(job) -> None:
     workdir, name, truth, seed, design, signal_model = job
     out = workdir / name
     if signal_model == "second":
-        write_second_rig(out, conditions(design), truth, seed, name)
+        from validation.gap_bench_second import write_second_campaign
+
+        write_second_campaign(out, conditions(design), truth, seed, name, design.duration_s)
     else:
         generate_campaign(out, conditions(design), seed=seed, duration_s=design.duration_s,
                           testbed=Testbed(law=tm.ModelLaw(truth), campaign=name))

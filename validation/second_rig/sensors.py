@@ -117,13 +117,14 @@ def quantise(x: np.ndarray, step: float) -> np.ndarray:
 
 def sample_clock(rate_hz: float, duration_s: float, sensor: SensorModel,
                  rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, dict]:
-    """True sample times and their logged ``t_ns``: random phase, rate error, jitter, whole
-    clock steps, a fraction of samples dropped (never the first or last)."""
+    """True sample times (>= 0) and their logged ``t_ns``: random phase, rate error, jitter,
+    whole clock steps, a fraction of samples dropped (never the first or last)."""
     dt = 1.0 / rate_hz
     ppm = rng.uniform(-sensor.clock_ppm_max, sensor.clock_ppm_max)
     k = np.arange(int((duration_s - dt) * rate_hz))
     jitter = np.clip(rng.normal(0, sensor.clock_jitter_s, k.size), -0.3 * dt, 0.3 * dt)
-    t_true = rng.uniform(0, dt) + k * dt + jitter
+    # the logger starts at 0: jitter cannot put the first sample before it
+    t_true = np.maximum(rng.uniform(0, dt) + k * dt + jitter, 0.0)
     keep = rng.random(k.size) >= sensor.dropped_fraction
     keep[[0, -1]] = True
     t_true = t_true[keep]
