@@ -46,6 +46,6 @@ def gap_report(points: pd.DataFrame, simulated: Simulated, measured_label: str,
                        else simulated.wheel.geometry(),
                        "model_wheel": simulated.wheel.geometry(), "mismatches": mismatches}
     tested = sorted({e for c in diagnosis["candidates"] for e in c["effects"]})
-    described = describe_sources(points, simulated, tested)
+    described = describe_sources(points, simulated, tested, settings.laws)
     report["sources"], report["effect_sources"] = described["sources"], described["effects"]
     return report

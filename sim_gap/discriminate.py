@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from sim_gap.fit import quantities_of
+from sim_gap.points_csv import WHEEL_KEY
 from sim_gap.simulated import Simulated
 from sim_gap.vocabulary import model_error_floor
 from swtlab.domain.gravity import MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2
@@ -54,12 +55,22 @@ def proposals(points: pd.DataFrame, grousered: bool = False
 
 def separating_test(sim: Simulated, points: pd.DataFrame, values_a: dict[str, float],
                     values_b: dict[str, float]) -> dict:
-    """The proposal with the largest standardised difference between the two fits."""
+    """The proposal with the largest standardised difference between the two fits. With
+    each source simulated on its own wheel (``sim.wheel_per_row``) a proposal is run on
+    every measured wheel, and a smooth wheel is proposed only when no source has one."""
     quantities = quantities_of(points)
     best = {"test": None, "separation_sigma": 0.0}
-    wheel = sim.model.wheel
-    for text, grid, change in proposals(points, wheel.grouser_count > 0
-                                        and wheel.grouser_height_m > 0):
+    if sim.wheel_per_row:
+        wheels = points[list(WHEEL_KEY)].drop_duplicates()
+        grousered = bool(((wheels["grouser_count"] > 0) & (wheels["grouser_height_m"] > 0)).all())
+    else:
+        wheels, grousered = None, sim.wheel.grouser_count > 0 and sim.wheel.grouser_height_m > 0
+    for text, grid, change in proposals(points, grousered):
+        if wheels is not None:
+            grid = grid.merge(wheels, how="cross")
+            if change:  # the smooth wheel is the row's wheel here, not a model parameter
+                grid = grid.assign(grouser_count=0, grouser_height_m=0.0)
+                change = {}
         a, b = sim.predict(grid, {**values_a, **change}), sim.predict(grid, {**values_b, **change})
         load = grid["wheel_load_n"].to_numpy(float)
         sep = max(float(np.nanmax(np.abs(a[q] - b[q]) / model_error_floor(q, load, sim.radius_m)))

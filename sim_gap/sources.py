@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from sim_gap.candidates import allowed_laws
 from sim_gap.diagnose import testable
 from sim_gap.simulated import Simulated
 
@@ -23,10 +24,12 @@ def _subset(points: pd.DataFrame, mask) -> pd.DataFrame:
     return out
 
 
-def describe_sources(points: pd.DataFrame, sim: Simulated, effects: list[str]) -> dict:
+def describe_sources(points: pd.DataFrame, sim: Simulated, effects: list[str],
+                     laws: dict[str, tuple[str, ...]] | None = None) -> dict:
     """``sources``: per source its wheel, point count and condition levels; ``effects``:
-    per tested effect the sources whose prediction it changes (by the untestable
-    threshold of :func:`sim_gap.diagnose.testable`) and a sentence saying so."""
+    per tested effect the sources whose prediction it changes under one of its ``laws``
+    (those the diagnosis may use; default every law) by the untestable threshold of
+    :func:`sim_gap.diagnose.testable`, and a sentence saying so."""
     source = (points["source"] if "source" in points
               else pd.Series(points.attrs.get("source", "measured"), index=points.index))
     names = list(dict.fromkeys(source))
@@ -42,7 +45,8 @@ def describe_sources(points: pd.DataFrame, sim: Simulated, effects: list[str]) -
             "loads_n": sorted(float(v) for v in rows["load_set_n"].unique()),
             "multipass": sorted(int(v) for v in rows["multipass"].unique()),
             "gravity_mps2": sorted(float(v) for v in rows["gravity_mps2"].unique())})
-        shown = effects if len(names) == 1 else testable(sim, _subset(points, mask), effects)[0]
+        shown = effects if len(names) == 1 else testable(
+            sim, _subset(points, mask), allowed_laws(sim.model, effects, laws))[0]
         for effect in shown:
             seen_on[effect].append(name)
     return {"sources": sources,
