@@ -37,20 +37,39 @@ SOIL_ONLY = "soil_only"
 SOIL_ONLY_TEXT = "soil recalibration only"
 
 
+def law_text(law: str) -> str:
+    """A law's key (``wong_kobayashi2012``) as its authors and year (Wong & Kobayashi 2012)."""
+    match = re.fullmatch(r"([a-z_]+?)(\d{4})", law)
+    if not match:
+        return law
+    return " & ".join(n.capitalize() for n in match.group(1).split("_")) + " " + match.group(2)
+
+
+def _effect_text(part: str) -> str:
+    """``slip_sinkage`` or ``slip_sinkage(lyasko2010)`` in plain words."""
+    effect, _, law = part.partition("(")
+    name = EFFECTS.get(effect, effect)
+    return f"{name} ({law_text(law.rstrip(')'))})" if law else name
+
+
 def candidate_text(label: str) -> str:
-    """A candidate label (``soil_only``, ``slip_sinkage+grousers``) in plain words."""
+    """A candidate label (``soil_only``, ``slip_sinkage+grousers``, with laws
+    ``grousers(ding2011)+slip_sinkage(lyasko2010)``) in plain words."""
     if label == SOIL_ONLY:
         return SOIL_ONLY_TEXT
-    return " + ".join(EFFECTS.get(e, e) for e in label.split("+"))
+    return " + ".join(_effect_text(e) for e in label.split("+"))
 
 
 def words(text: str, labels: list[str]) -> str:
-    """``text`` (written with the JSON's candidate labels and effect names) in plain words:
-    each label by its plain name, standard errors and sigmas spelt out."""
-    names = sorted({n for n in {*labels, *EFFECTS, SOIL_ONLY} if "_" in n or "+" in n},
-                   key=len, reverse=True)
+    """``text`` (written with the JSON's candidate labels, effect names and law keys) in plain
+    words: each label by its plain name, each law by its authors and year, standard errors
+    and sigmas spelt out."""
+    sets = {re.sub(r"\([^)]*\)", "", n) for n in labels}  # the effect sets, laws dropped
+    names = sorted({n for n in {*labels, *sets, *EFFECTS, SOIL_ONLY}
+                    if "_" in n or "+" in n or "(" in n}, key=len, reverse=True)
     pattern = re.compile(r"(?<![\w+])(" + "|".join(map(re.escape, names)) + r")(?![\w+])")
     text = pattern.sub(lambda m: candidate_text(m.group(1)), text)
+    text = re.sub(r"\b[a-z_]+\d{4}\b", lambda m: law_text(m.group(0)), text)  # a law's key
     text = re.sub(r"(\d) SE\b", r"\1 standard errors", text)
     return re.sub(r"\bsigma\b", "σ", text).replace("m/s^2", "m/s²").strip()
 

@@ -194,6 +194,19 @@ def test_plain_words_and_display_units():
                  "(40 % of the held-out loss)", ["slip_sinkage+grousers"]) == (
         "Slip sinkage + grousers improves on soil-only recalibration by only 3.1 standard "
         "errors (40 % of the held-out loss).")
+    # candidates with their laws, effect sets and law keys in a law-dependent reason
+    assert candidate_text("grousers(ding2011)+reduced_gravity(wong_kobayashi2012)") == (
+        "grousers (Ding 2011) + reduced gravity (Wong & Kobayashi 2012)")
+    keys = ["slip_sinkage(ding2011)", "grousers(ding2011)+slip_sinkage(lyasko2010)"]
+    assert plain("under the best-fitting laws the verdict is slip_sinkage (slip_sinkage"
+                 "(ding2011)), but with slip_sinkage under lyasko2010 it is grousers+slip_sinkage "
+                 "(grousers(ding2011)+slip_sinkage(lyasko2010)) on ding2011_lug10", keys) == (
+        "Under the best-fitting laws the verdict is slip sinkage (slip sinkage (Ding 2011)), "
+        "but with slip sinkage under Lyasko 2010 it is grousers + slip sinkage (grousers "
+        "(Ding 2011) + slip sinkage (Lyasko 2010)) on ding2011_lug10.")
+    for effect, laws in tm.LAWS.items():
+        for law in laws:
+            assert "_" not in candidate_text(f"{effect}({law})")
     two = {"candidates": [], "decision": {"leaders": ["grousers", "slip_sinkage"]},
            "separating_test": {
         "test": "test at another gravity (3.71 m/s^2, gravity-offload rig or parabolic flight)",
