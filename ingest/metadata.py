@@ -82,6 +82,9 @@ class RunMetadata:
     camera_track: CameraTrackInfo | None = None
     zero: dict[str, float] = field(default_factory=dict)
     calibration: dict[tuple[str, str], tuple[float, float]] = field(default_factory=dict)
+    #: (topic, field) -> (relative standard uncertainty of the gain, standard uncertainty of
+    #: the offset in SI units), where ``swt.calibration`` states them (0 where it states one)
+    calibration_u: dict[tuple[str, str], tuple[float, float]] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """Plain JSON-ready dict (datetimes as ISO strings, calibration keys as 'topic.field')."""
@@ -96,6 +99,8 @@ class RunMetadata:
         out["zero"] = dict(self.zero)
         out["calibration"] = {f"{t}.{f}": {"gain": g, "offset": o}
                               for (t, f), (g, o) in self.calibration.items()}
+        out["calibration_u"] = {f"{t}.{f}": {"gain_rel_u": g, "offset_u": o}
+                                for (t, f), (g, o) in self.calibration_u.items()}
         return out
 
 
@@ -234,23 +239,34 @@ def _zero(path: Path, values: Mapping[str, Any]) -> dict[str, float]:
     return {k: r.number(k) for k in WRENCH_FIELDS if k in values}
 
 
-def _calibration(path: Path,
-                 values: Mapping[str, Any]) -> dict[tuple[str, str], tuple[float, float]]:
+CALIBRATION_PARTS = ("gain", "offset", "gain_rel_u", "offset_u")  # raw-run spec, swt.calibration
+
+
+def _calibration(path: Path, values: Mapping[str, Any]
+                 ) -> tuple[dict[tuple[str, str], tuple[float, float]],
+                            dict[tuple[str, str], tuple[float, float]]]:
+    """``(gain, offset)`` and, where stated, ``(gain_rel_u, offset_u)`` per (topic, field)."""
     r = _Reader(path, "calibration", values)
     parts: dict[tuple[str, str], dict[str, float]] = {}
     for key in values:
         topic, _, rest = key.rpartition(".")
         topic, _, fld = topic.rpartition(".")
-        if rest not in ("gain", "offset") or not topic or not fld:
-            raise r.fail(key, "expected '<topic>.<field>.gain' or '<topic>.<field>.offset'")
-        parts.setdefault((topic, fld), {})[rest] = r.number(key)
-    out = {}
+        if rest not in CALIBRATION_PARTS or not topic or not fld:
+            raise r.fail(key, "expected '<topic>.<field>.' followed by one of "
+                              f"{', '.join(CALIBRATION_PARTS)}")
+        number = r.number(key)
+        if rest.endswith("_u") and number < 0:
+            raise r.fail(key, f"a standard uncertainty must be >= 0, got {number:g}")
+        parts.setdefault((topic, fld), {})[rest] = number
+    out, uncertainty = {}, {}
     for (topic, fld), p in parts.items():
         gain = p.get("gain", 1.0)
         if gain == 0:
             raise r.fail(f"{topic}.{fld}.gain", "a gain of 0 would erase the channel")
         out[(topic, fld)] = (gain, p.get("offset", 0.0))
-    return out
+        if "gain_rel_u" in p or "offset_u" in p:
+            uncertainty[(topic, fld)] = (p.get("gain_rel_u", 0.0), p.get("offset_u", 0.0))
+    return out, uncertainty
 
 
 def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
@@ -282,11 +298,12 @@ def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
         camera_track = CameraTrackInfo(
             px_per_m=_Reader(path, "camera_track", records["camera_track"]).positive("px_per_m"))
     run = _run_info(path, records["run"])
+    calibration, calibration_u = _calibration(path, records.get("calibration", {}))
     metadata = RunMetadata(
         run=run, wheel=_wheel_info(path, records["wheel"], run.wheel),
         suspension=suspension,
         camera=_camera_info(path, records["camera"]) if "camera" in records else None,
         camera_track=camera_track,
         zero=_zero(path, records.get("zero", {})),
-        calibration=_calibration(path, records.get("calibration", {})))
+        calibration=calibration, calibration_u=calibration_u)
     return metadata, problems

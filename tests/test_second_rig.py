@@ -220,11 +220,11 @@ def test_bad_input_gives_one_line_errors(tmp_path):
                        form="hdf5")
 
 
-@pytest.mark.xfail(strict=True, raises=ingest.IngestError,
-                   reason="ingest rejects the spec's optional swt.calibration uncertainty keys "
-                          "(<topic>.<field>.gain_rel_u, .offset_u)")
 def test_ingest_reads_the_specs_calibration_uncertainty_keys(tmp_path):
-    rig = Rig(sensors=SensorModel(write_calibration_uncertainty=True, dp_raw_ratio=1.0))
+    sensors = SensorModel(write_calibration_uncertainty=True, dp_raw_ratio=1.0)
     write_campaign(tmp_path, [RunCondition("u", "speed_control", 150.0, 0.2)], constant_law,
-                   seed=2, rig=rig)
-    assert ingest.read_run(tmp_path / "campaign" / "u.mcap").run_id == "u"
+                   seed=2, rig=Rig(sensors=sensors))
+    run = ingest.read_run(tmp_path / "campaign" / "u.mcap")
+    u = run.metadata.calibration_u
+    assert u[("/tether/force", "dp")] == (sensors.gain_rel_u, sensors.dp_offset_u_n)
+    assert u[("/hub/wrench", "fz")][0] == sensors.gain_rel_u
