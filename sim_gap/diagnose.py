@@ -20,12 +20,14 @@ from sim_gap.laws import reference_laws, robust_decide
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
 from sim_gap.simulated import Simulated
+from swtlab.domain.gravity import G0_MPS2
 
 #: a standardised prediction change below this (max over points) makes an effect untestable
 TESTABLE_SIGMA = 0.2
 #: what each effect needs from a campaign to show (for the untestable list)
 CONTRAST_NEEDED = {"multipass": "a second multipass level",
-                   "reduced_gravity": "a gravity level other than standard gravity (9.80665 m/s^2)",
+                   "reduced_gravity": "a gravity level other than standard gravity "
+                                      f"({G0_MPS2:g} m/s^2)",
                    "grousers": "a wheel with grousers (a grouser count and height in the model)",
                    "slip_sinkage": "several slips", "wheel_flexibility": "a flexible wheel",
                    "bulldozing": "measurable sinkage"}
