@@ -161,6 +161,7 @@ class WheelModel:
         s, shape = self.soil, cond.slip.shape
         full = lambda v: np.full(shape, float(v))  # noqa: E731
         return SoilState(kc=full(s.kc), kphi=full(s.kphi), n0=full(s.n), n_slope=full(0.0),
+                         n_skid_slope=full(0.0),
                          cohesion_pa=full(s.cohesion_pa),
                          phi_rad=full(np.radians(s.friction_angle_deg)),
                          shear_modulus_m=slip_soil_ding2015.shear_modulus_m(
@@ -181,9 +182,12 @@ class _ContactForces:
         b = geo.width_m
         self.soil, self.geo, self.width = soil, geo, b
         self.k_reece = (soil.kc / b + soil.kphi) * b ** soil.n0
-        self.n = soil.n0 + soil.n_slope * np.abs(cond.slip)
         self.slip = cond.slip
         self.skid = cond.slip < 0
+        # Ding et al. 2011 N = n0 + n1 s driving; n0 + n2 |s| braked (Pavlov & Johnson's
+        # CMU model, robomechanics/3d-terramechanics sigma.m)
+        slope = np.where(self.skid, soil.n_skid_slope, soil.n_slope)
+        self.n = soil.n0 + slope * np.abs(cond.slip)
 
     def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
         soil, geo, b = self.soil, self.geo, self.width

@@ -80,12 +80,13 @@ def shipped_model(name: str) -> WheelModel:
 
 def model_to_dict(model: WheelModel) -> dict:
     """The tables of a model file; effects that are off are written with enabled = false
-    (with their default law)."""
+    (with their default law); an unset (None) law parameter is left out."""
     effects = {}
     for name, cls in EFFECTS.items():
         effect = model.effects.get(name) or cls()
         effects[name] = {"enabled": name in model.effects, "law": effect.law,
-                         **dataclasses.asdict(effect)}
+                         **{k: v for k, v in dataclasses.asdict(effect).items()
+                            if v is not None}}
     return {"model": {"gravity_mps2": model.gravity_mps2},
             "wheel": {k: v for k, v in dataclasses.asdict(model.wheel).items()
                       if v is not None and v != ""},

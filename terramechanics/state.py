@@ -29,7 +29,8 @@ class SoilState:
     kc: np.ndarray
     kphi: np.ndarray
     n0: np.ndarray
-    n_slope: np.ndarray  # dn/d|s| (slip-sinkage), 0 without the effect
+    n_slope: np.ndarray  # dn/ds when driving (slip-sinkage), 0 without the effect
+    n_skid_slope: np.ndarray  # dn/d|s| when braked (skid ratio s < 0), 0 without it
     cohesion_pa: np.ndarray
     phi_rad: np.ndarray
     shear_modulus_m: np.ndarray

@@ -12,7 +12,8 @@ the lug height, ``n1_lug = kappa h / r`` (a linearisation in h of their per-whee
 values), added to the soil's own slip-sinkage. The default kappa = 3 is fitted on the
 Ding et al. 2011 10 mm lug wheel at 80 N (bench/bench_ding2011.py, ``static_k`` soil,
 the smooth wheel's ``slip_sinkage`` n1 = 0.9); that wheel is then no hold-out for this
-law. It holds for lugs short against the radius (h/r <= 0.1 in their tests).
+law. It holds for lugs short against the radius (h/r <= 0.1 in their tests); the same slope
+on the braked branch (|s|) is an extension outside their data.
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ class GrousersDing2011(Effect):
 
     def soil(self, soil, cond, wheel):
         lug_n1 = self.lug_sinkage_gain * wheel.grouser_height_m / wheel.radius_m
-        return replace(soil, n_slope=soil.n_slope + lug_n1)
+        return replace(soil, n_slope=soil.n_slope + lug_n1,
+                       n_skid_slope=soil.n_skid_slope + lug_n1)
 
     def geometry(self, geo, soil, cond, wheel):
         offset = self.shear_radius_factor * wheel.grouser_height_m
