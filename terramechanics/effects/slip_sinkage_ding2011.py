@@ -1,4 +1,4 @@
-"""Slip-sinkage after Ding et al.: the sinkage exponent grows with slip, ``n = n0 + n1 |s|``.
+"""Slip-sinkage after Ding et al.: the sinkage exponent grows with slip, ``n = n0 + n1 s``.
 
 Ding, Gao, Deng, Nagatani & Yoshida (2011) "Experimental study and analysis on driving wheels'
 performance for planetary exploration rovers moving in deformable soil",
@@ -12,9 +12,10 @@ the CMU model of Pavlov & Johnson (robomechanics/3d-terramechanics, ``sigma.m``;
 hand-tuned smooth wheel on dry sand: n1 = 0.01, n2 = 0.55, i.e. sinkage grows with
 skid, hardly with slip; their ``k z^N`` is kept here in Reece's form, so their values
 carry over approximately); ``n2`` unset takes n1 on both branches (an extension of
-Ding's law outside their data). Only n1 is freed by a gap fit. The default n1 = 0.5 makes a BB2-like wheel sink about four times
-deeper at 90 % slip than at zero slip; on the smooth wheel of Ding et al. 2011 at 80 N
-bench/bench_ding2011.py fits n1 = 0.9 (soil stiffness set by the zero-slip sinkage).
+Ding's law outside their data). Only n1 is freed by a gap fit. The default n1 = 0.5
+makes a BB2-like wheel sink about four times deeper at 90 % slip than at zero slip; on
+the smooth wheel of Ding et al. 2011 at 80 N bench/bench_ding2011.py fits n1 = 0.9 (soil
+stiffness set by the zero-slip sinkage).
 """
 
 from __future__ import annotations
