@@ -127,11 +127,13 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
                       + f", and every rival of the same size by more than {Z_TIE:g} SE"}
 
 
-def unless_unidentifiable(decision: dict, problem: str | None) -> dict:
-    """A confident verdict (effects or ``[]``) becomes ``inconclusive`` when the campaign
-    cannot identify the chosen candidate's parameters (``problem``: the reason, from
-    :func:`sim_gap.identify.identification_problem`; None keeps the decision)."""
+def unless(decision: dict, problem: str | None, flag: str) -> dict:
+    """A confident verdict (effects or ``[]``) becomes ``inconclusive`` with ``problem`` as
+    its reason and ``decision[flag] = True`` (None keeps the decision): ``unidentifiable``
+    when the points cannot identify the chosen candidate's parameters
+    (:func:`sim_gap.identify.identification_problem`), ``aliased`` when the design cannot
+    tell the call's effect from another (:func:`sim_gap.aliasing.aliasing_problem`)."""
     if problem is None or decision["verdict"] == "inconclusive":
         return decision
-    return {**decision, "verdict": "inconclusive", "leaders": [], "unidentifiable": True,
+    return {**decision, "verdict": "inconclusive", "leaders": [], flag: True,
             "reason": problem}

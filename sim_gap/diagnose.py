@@ -12,7 +12,8 @@ import pandas as pd
 
 from sim_gap import candidates as cands
 from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
-from sim_gap.decide import rank, unless_unidentifiable
+from sim_gap.aliasing import SEPARATING_RUN, aliasing_problem
+from sim_gap.decide import rank, unless
 from sim_gap.discriminate import separating_test
 from sim_gap.fit import quantities_of, sigmas
 from sim_gap.identify import identification_problem
@@ -114,14 +115,20 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     results.update(_run_all(sim, pairs, points, sig, settings,
                             [_pair_start(c, results) for c in pairs]))
     decision = robust_decide(results, allowed, reference, n)
-    decision = unless_unidentifiable(decision, identification_problem(
-        sim, results[decision["chosen"]].full, points, sig))
+    chosen = results[decision["chosen"]].full
+    decision = unless(decision, identification_problem(sim, chosen, points, sig),
+                      "unidentifiable")
+    decision = unless(decision, aliasing_problem(
+        points, sim.model.wheel, list(chosen.candidate.effects),
+        dict(zip(chosen.candidate.effects, chosen.candidate.laws)), chosen.values), "aliased")
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
                                "out: " + ", ".join(sorted(untestable)))
     regions = residual_map(points, sim.predict(points, {}),
                            sim.predict(points, results["soil_only"].full.values), sim.radius_m)
-    if decision["verdict"] == "inconclusive" and len(decision["leaders"]) == 2:
+    if decision.get("aliased"):
+        decision["separating_test"] = {"test": SEPARATING_RUN, "separation_sigma": None}
+    elif decision["verdict"] == "inconclusive" and len(decision["leaders"]) == 2:
         a, b = (results[key].full.values for key in decision["leaders"])
         decision["separating_test"] = separating_test(sim, points, a, b)
     elif decision["verdict"] == "inconclusive":

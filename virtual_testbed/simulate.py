@@ -145,12 +145,16 @@ def simulate_true_run(condition: RunCondition, law: PerformanceLaw, wheel: Wheel
     resistance = law_ss["resistance_n"] * sinkage_base / z_ss * shear
     thrust = resistance if c.mode == "free_sled" else law_ss["thrust_n"] * shear
 
-    in_contact = grousers.grousers_in_contact(z_ss, wheel.radius_m, wheel.grouser_height_m,
-                                              wheel.grouser_count)
-    n, pitch_rad = wheel.grouser_count, 2.0 * np.pi / wheel.grouser_count
-    osc = grousers.oscillation_shape(wheel_angle + phase_rad, n, in_contact) * shear
-    osc_fz = grousers.oscillation_shape(wheel_angle + phase_rad + pitch_rad / 4, n,
-                                        in_contact) * shear
+    n = wheel.grouser_count
+    if n > 0 and wheel.grouser_height_m > 0:
+        in_contact = grousers.grousers_in_contact(z_ss, wheel.radius_m, wheel.grouser_height_m, n)
+        pitch_rad = 2.0 * np.pi / n
+        osc = grousers.oscillation_shape(wheel_angle + phase_rad, n, in_contact) * shear
+        osc_fz = grousers.oscillation_shape(wheel_angle + phase_rad + pitch_rad / 4, n,
+                                            in_contact) * shear
+    else:  # a smooth rim: no grouser passing oscillation
+        in_contact, osc = 0.0, np.zeros_like(t)
+        osc_fz = osc
     w = c.load_n
     fx = thrust - resistance + dyn.dp_oscillation_ratio * w * osc
     signals = {
