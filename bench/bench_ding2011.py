@@ -13,7 +13,11 @@ slip-dependent shear modulus K = K0 + K1 s of Ding et al. 2015
 held out on the other (``+ exit angle c4``: with the slope of Ding's exit angle
 freed too); ``constant K`` is the same fit with K1 = 0, the control. No
 K0, K1 for this simulant is published in a source swtlab has, so every slip_shear row
-is fitted. The torque column is never fitted.
+is fitted. The torque column is never fitted. ``textbook`` rows (published soil only): the
+textbook theta_m = (0.4 + 0.2 s) theta_1 (Wong 2008, ch. 2) and/or K at the ends of
+Ding's published range 9.7-13.1 mm, nothing fitted: the spread the "published" soil
+allows (issue 15's "Bekker-Wong with the published soil: about 27-32 %" is DP with
+c1 = 0.4, c2 = 0.2 and K = 9.7 mm; the sinkage stays 42-55 % for all of them).
 """
 
 from __future__ import annotations
@@ -62,6 +66,22 @@ def cases(base: WheelModel, points) -> list[tuple[str, str, WheelModel, str]]:
     ]
 
 
+def textbook_cases(base: WheelModel) -> list[tuple[str, str, WheelModel, str]]:
+    """(label, wheel, model, '-') for the textbook theta_m coefficients and the ends of the
+    published K range, both wheels (the lug wheel also with grousers bekker1956)."""
+    out = []
+    for label, soil in (("textbook c1=0.4 c2=0.2", {"c1": 0.4, "c2": 0.2}),
+                        ("K = 9.7 mm", {"shear_modulus_m": 0.0097}),
+                        ("K = 13.1 mm", {"shear_modulus_m": 0.0131}),
+                        ("textbook c1=0.4 c2=0.2, K = 9.7 mm",
+                         {"c1": 0.4, "c2": 0.2, "shear_modulus_m": 0.0097})):
+        model = base.with_soil(**soil)
+        out += [(label, "smooth", model, "-"), (label, "lug10", model, "-"),
+                (f"{label} + grousers bekker1956", "lug10", model.with_effects(grousers=True),
+                 "-")]
+    return out
+
+
 def slip_shear_cases(base: WheelModel, points) -> list[tuple[str, str, WheelModel | None, str]]:
     """(label, wheel, model or None when the fit ends on a bound, what was fitted): each
     fit of K0, K1, n1 (or K0, n1 for constant K) on one wheel, shown on both."""
@@ -107,7 +127,9 @@ def main(quick: bool = False) -> dict:
     print(f"{'soil':<30}{'model':<60}{'wheel':<8}{'DP med':>8}{'z med':>8}{'T med':>8}"
           "  fitted")
     for setting, base in settings(points).items():
-        for label, name, model, fitted in cases(base, points) + slip_shear_cases(base, points):
+        extra = textbook_cases(base) if setting == "published" else []
+        for label, name, model, fitted in (cases(base, points) + extra
+                                           + slip_shear_cases(base, points)):
             key = f"{setting} | {label} | {name}"
             if model is None:
                 numbers[key] = {"fitted": fitted}

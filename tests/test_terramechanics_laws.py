@@ -246,3 +246,53 @@ def test_ding2011_accuracy_with_held_out_laws():
         assert err["dp_median_rel"] <= 0.30
     lug_off = ding2011.errors(model.with_effects(grousers=False), points, "lug10")
     assert ding2011.errors(model, points, "lug10")["dp_median_rel"] < lug_off["dp_median_rel"]
+
+
+def _hand_static_sinkage_m(c1: float) -> float:
+    """Sinkage of the Ding et al. 2011 wheel (R = 157.35 mm, b = 165 mm) at 80 N and s = 0 on
+    the paper's Table 2 soil, by adaptive quadrature of Wong & Reece (1967, J. Terramech.
+    4(1)) part I: sigma = (kc/b + kphi) (r (cos t - cos t1))^n in front of
+    theta_m = c1 theta_1, the same law at the mirrored angle behind it (theta_2 = 0),
+    Janosi-Hanamoto shear with j = r [(t1 - t) - (sin t1 - sin t)] at s = 0, and
+    W = b r int (sigma cos t + tau sin t) dt solved for theta_1."""
+    from scipy.integrate import quad
+    from scipy.optimize import brentq
+    r, b, n = 0.15735, 0.165, 1.10
+    k, c, tan_phi, shear_k = 15.6e3 / b + 2407.4e3, 250.0, np.tan(np.radians(31.9)), 0.011
+
+    def load(t1):
+        tm_ = c1 * t1
+
+        def sigma(t):
+            equiv = t if t >= tm_ else t1 - t / tm_ * (t1 - tm_)
+            return k * (r * max(np.cos(equiv) - np.cos(t1), 0.0)) ** n
+
+        def tau(t):
+            j = r * ((t1 - t) - (np.sin(t1) - np.sin(t)))
+            return (c + sigma(t) * tan_phi) * -np.expm1(-j / shear_k)
+
+        return b * r * quad(lambda t: sigma(t) * np.cos(t) + tau(t) * np.sin(t), 0.0, t1,
+                            points=[tm_] if tm_ > 0 else None, limit=200)[0]
+
+    return 0.15735 * (1 - np.cos(brentq(lambda t: load(t) - 80.0, 1e-3, 1.2, xtol=1e-12)))
+
+
+def test_ding2011_published_soil_static_sinkage_is_what_the_equations_give():
+    """The plain model's 11.6 mm at rest on Ding's Table 2 soil (5.0 mm measured) is the
+    Wong-Reece answer for that soil, not a coding error: an independent quadrature gives
+    the same; with theta_m = 0 both give Bekker's closed form for a rigid wheel (Bekker
+    1969, Introduction to Terrain-Vehicle Systems; Wong, Theory of Ground Vehicles 2008,
+    ch. 2), z0 = [3W / ((3 - n)(kc + b kphi) sqrt(D))]^(2/(2n + 1)) = 9.13 mm (its
+    small-angle approximations: within 2 %). The textbook theta_m = 0.4 theta_1 (c1 = 0.4,
+    c2 = 0.2) sinks it 11.3 mm; no theta_m brings it near 5 mm."""
+    points = ding2011.load_points()
+    published = tm.WheelModel(ding2011.wheel(points, "smooth"), ding2011.SOIL)
+    bekker = (3 * 80.0 / ((3 - 1.10) * (15.6e3 + 0.165 * 2407.4e3) * np.sqrt(2 * 0.15735))
+              ) ** (2 / (2 * 1.10 + 1))
+    assert bekker == pytest.approx(9.13e-3, abs=0.01e-3)
+    for c1, c2 in ((0.43, 0.32), (0.4, 0.2), (0.0, 0.0)):
+        z = float(published.with_soil(c1=c1, c2=c2).curves(80.0, 0.0)["sinkage_m"])
+        assert z == pytest.approx(_hand_static_sinkage_m(c1), rel=1e-5)
+        assert z > 1.75 * 5.0e-3  # measured 5.0 mm
+    z0 = float(published.with_soil(c1=0.0, c2=0.0).curves(80.0, 0.0)["sinkage_m"])
+    assert z0 == pytest.approx(bekker, rel=0.02)
