@@ -112,3 +112,17 @@ def test_suspension_angle_gives_the_sinkage():
     angle = suspension_angle_rad(0.02, 180.0, flexible, sus)
     hub_height = 0.6 * (np.sin(angle) - np.sin(0.05))
     assert -hub_height - 180.0 / (1000.0 * 60.0) == pytest.approx(0.02)
+
+
+def test_smooth_wheel_has_no_grouser_oscillation():
+    """A smooth rim (no grousers): the run simulates, DP and torque follow the steady law
+    without the passing oscillation, no grousers in contact."""
+    smooth = replace(BB2_WHEEL, grouser_count=0, grouser_height_m=0.0)
+    cond = RunCondition("x", "speed_control", 180.0, 0, 0.3)
+    run = simulate_true_run(cond, LAW, smooth, TL, DYN)
+    t = run.signals["t_s"]
+    window = (t > TL.window_start_s) & (t < TL.decel_start_s)
+    dp = run.signals["dp_n"][window]
+    assert run.grousers_in_contact == 0.0
+    np.testing.assert_allclose(dp, run.signals["dp_trend_n"][window], rtol=0, atol=1e-12)
+    assert np.std(dp) < 1e-3 * abs(run.steady["dp_n"])
