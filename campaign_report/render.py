@@ -95,7 +95,7 @@ def write_report(db_url: str, path: str | Path, campaign: str | None = None,
 
     Raises ``LookupError`` (one line, what to do) when the database has no processed run,
     no such campaign, or several campaigns and none was named."""
-    with open_database(db_url)() as session:
+    with open_database(db_url, read_only=True)() as session:
         names = campaign_names(session)
         if not names:
             raise LookupError(f"{db_url}: no processed runs (run swtlab process first)")
@@ -112,7 +112,7 @@ def write_report(db_url: str, path: str | Path, campaign: str | None = None,
 def write_reports(db_url: str, path: str | Path,
                   progress: Progress = _no_progress) -> dict[str, Path]:
     """One page per campaign of the database, named by :func:`page_paths`: campaign -> page."""
-    with open_database(db_url)() as session:
+    with open_database(db_url, read_only=True)() as session:
         names = campaign_names(session)
     if not names:
         raise LookupError(f"{db_url}: no processed runs (run swtlab process first)")

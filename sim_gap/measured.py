@@ -111,7 +111,7 @@ def from_database(url: str) -> pd.DataFrame:
     from traceability import open_database
     from traceability.queries import latest_results
 
-    with open_database(url)() as session:
+    with open_database(url, read_only=True)() as session:
         return from_results_table(latest_results(session), source=url)
 
 

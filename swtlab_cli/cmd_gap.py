@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
         from traceability import open_database
         from traceability.store_gap import store_gap_report
 
-        with open_database(args.measured[0]).begin() as session:
+        with open_database(args.measured[0], create=False).begin() as session:
             store_gap_report(session, report)
     for line in report["wheel"]["mismatches"]:
         print(f"wheel mismatch allowed: {line}")

@@ -25,7 +25,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="One row per run: identifiers and conditions, status and flags, the stable "
                     "window, and each quantity's mean, standard deviation and standard error in "
                     "SI units (columns: docs/results.md). Without --csv/--json, a summary table.")
-    parser.add_argument("--db", required=True, help="SQLAlchemy URL")
+    parser.add_argument("--db", required=True,
+                        help="database URL or SQLite file path (read, never created or upgraded)")
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")
     out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
@@ -39,12 +40,16 @@ def run(args: argparse.Namespace) -> int:
     from traceability import open_database
     from traceability.queries import latest_results
 
-    with open_database(args.db)() as session:
+    with open_database(args.db, read_only=True)() as session:
         table = latest_results(session)
     if table.empty:
         print(f"swtlab results: {args.db}: no processed runs (run swtlab process first)",
               file=sys.stderr)
         return exit_codes.BAD_INPUT
+    missing = table.loc[table["raw_file_missing"], "raw_file_path"]
+    if len(missing):
+        print(f"swtlab results: notice: the raw files of {len(missing)} runs are missing "
+              f"(marked by swtlab process): {'; '.join(missing)}", file=sys.stderr)
     if args.towed:
         from run_results import towed_vs_powered
 
