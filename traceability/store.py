@@ -18,7 +18,7 @@ from sqlalchemy.orm import Session
 
 from traceability.hashing import content_sha256
 from traceability.provenance import lock_sha256, swtlab_version
-from traceability.text import checked_name
+from traceability.text import TextRefused, checked_name
 from traceability.models import (Calibration, Campaign, ProcessingRecord, RawFile, Run, Soil,
                                  TestCondition, Wheel)
 
@@ -119,13 +119,15 @@ def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, An
     processing record of a new version; an unchanged file writes nothing."""
     meta = run.metadata
     path = str(Path(run.source).resolve())
-    for what, name in (("campaign", meta.run.campaign), ("run_id", meta.run.run_id),
-                       ("wheel", meta.run.wheel), ("soil", meta.run.soil)):
-        checked_name(what, name)
     calibrations = _calibrations(meta)
-    for row in calibrations:
-        checked_name("topic", row.topic)
-        checked_name("field", row.field)
+    names = [("campaign", meta.run.campaign), ("run_id", meta.run.run_id),
+             ("wheel", meta.run.wheel), ("soil", meta.run.soil)]
+    names += [(what, getattr(row, what)) for row in calibrations for what in ("topic", "field")]
+    try:
+        for what, name in names:
+            checked_name(what, name)
+    except TextRefused as error:
+        raise TextRefused(f"{path}: {error}") from None
     sha256, size_bytes = content_sha256(Path(run.source))
     campaign = _get_or_create(session, Campaign, name=meta.run.campaign)
     known = session.scalars(select(RawFile).join(Run, Run.id == RawFile.run_pk).where(
