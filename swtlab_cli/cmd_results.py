@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from swtlab_cli import exit_codes
+from swtlab.atomic import atomic_file
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
                    "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
@@ -58,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"swtlab results: {args.db}: no towed runs", file=sys.stderr)
             return exit_codes.BAD_INPUT
     if args.csv:
-        table.to_csv(args.csv, index=False)
+        with atomic_file(args.csv, newline="") as stream:
+            table.to_csv(stream, index=False)
         print(f"{len(table)} runs written to {args.csv}")
     elif args.json:
         print(table.to_json(orient="records", indent=1))
