@@ -199,7 +199,8 @@ def in_transaction(factory: sessionmaker[Session], work: Callable[[Session], T],
             with factory.begin() as session:
                 return work(session)
         except (OperationalError, IntegrityError) as error:
-            if attempt == attempts - 1 or not _retryable(error):
+            unique = isinstance(error, IntegrityError)
+            if attempt >= (2 if unique else attempts - 1) or not _retryable(error):
                 raise
             time.sleep(delay_s * (1 + random.random()))
             delay_s = min(2 * delay_s, 5.0)
