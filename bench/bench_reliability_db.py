@@ -1,8 +1,8 @@
 """Database reliability (issue 17, item 9): kill points survived and concurrent writers.
 
-Kill points: ``swtlab process`` of a small campaign (sample runs) started again and again on one
-SQLite file and SIGKILLed at seeded random moments over its uninterrupted duration, then run to
-the end; the database must equal one processed without a kill (every run's version, path,
+Kill points: ``swtlab process`` of a small campaign (4 sample runs) on a fresh SQLite file,
+SIGKILLed at a seeded random moment of its uninterrupted duration, then run again to the end;
+each such database must equal one processed without a kill (every run's version, path,
 sha256, condition, status, window and quantities), with 0 duplicates, 0 orphans and SQLite's
 integrity and foreign-key checks clean.
 
@@ -127,34 +127,40 @@ def _sqlite_checks(path: Path) -> tuple[str, int]:
 
 
 def kill_points(kills: int, seed: int = 0) -> dict:
-    """SIGKILL ``kills`` times at random moments, finish, compare with an unkilled database."""
+    """``kills`` trials, each on a fresh SQLite file: SIGKILL at a random moment of the
+    uninterrupted duration, run again to the end, compare with an unkilled database."""
     rng = random.Random(seed)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
     with tempfile.TemporaryDirectory() as tmp:
         folder = _campaign(Path(tmp) / "campaign", KILL_RUNS)
         reference = f"sqlite:///{tmp}/reference.sqlite"
         start = time.perf_counter()
         subprocess.run(_command(folder, reference), cwd=ROOT, check=True,
-                       stdout=subprocess.DEVNULL, env={**os.environ, "PYTHONPATH": str(ROOT)})
+                       stdout=subprocess.DEVNULL, env=env)
         full_s = time.perf_counter() - start
-        killed_path = Path(tmp) / "killed.sqlite"
-        killed = f"sqlite:///{killed_path}"
-        landed = 0
-        for _ in range(kills):
+        expected = (_content(reference), _counts(reference))
+        survived = landed = duplicates = orphans = broken_keys = 0
+        integrity = set()
+        for trial in range(kills):
+            killed_path = Path(tmp) / f"killed{trial}.sqlite"
+            killed = f"sqlite:///{killed_path}"
             process = _start(folder, killed)
             time.sleep(rng.uniform(0.0, full_s))
-            if process.poll() is None:
-                process.send_signal(signal.SIGKILL)
-                landed += 1
+            landed += process.poll() is None
+            process.send_signal(signal.SIGKILL)
             process.wait(timeout=120)
-        subprocess.run(_command(folder, killed), cwd=ROOT, check=True,
-                       stdout=subprocess.DEVNULL, env={**os.environ, "PYTHONPATH": str(ROOT)})
-        identical = (_content(killed) == _content(reference)
-                     and _counts(killed) == _counts(reference))
-        duplicates, orphans = _duplicates_and_orphans(killed)
-        integrity, broken_keys = _sqlite_checks(killed_path)
-    return {"kills": kills, "kills_landed": landed, "runs": len(KILL_RUNS),
-            "uninterrupted_s": full_s, "identical": identical, "duplicates": duplicates,
-            "orphans": orphans, "integrity": integrity, "foreign_key_violations": broken_keys}
+            subprocess.run(_command(folder, killed), cwd=ROOT, check=True,
+                           stdout=subprocess.DEVNULL, env=env)
+            survived += (_content(killed), _counts(killed)) == expected
+            found = _duplicates_and_orphans(killed)
+            duplicates, orphans = duplicates + found[0], orphans + found[1]
+            check, keys = _sqlite_checks(killed_path)
+            integrity.add(check)
+            broken_keys += keys
+    return {"kills": kills, "kills_landed": landed, "survived": survived,
+            "runs": len(KILL_RUNS), "uninterrupted_s": full_s, "duplicates": duplicates,
+            "orphans": orphans, "integrity": sorted(integrity),
+            "foreign_key_violations": broken_keys}
 
 
 def _postgres_database(admin_url: str) -> tuple[str, callable]:
@@ -205,11 +211,12 @@ def concurrent_writers(backend: str, layout: str, runs: int) -> dict:
 
 def main(quick: bool = False) -> dict:
     kills = kill_points(6 if quick else 24)
-    print(f"kill points: {kills['kills']} SIGKILLs ({kills['kills_landed']} while running) of "
-          f"swtlab process over {kills['runs']} runs ({kills['uninterrupted_s']:.1f} s "
-          f"uninterrupted), then one run to the end: identical database {kills['identical']}, "
-          f"{kills['duplicates']} duplicates, {kills['orphans']} orphans, integrity "
-          f"{kills['integrity']}, {kills['foreign_key_violations']} foreign-key violations")
+    print(f"kill points: {kills['kills']} SIGKILLs of swtlab process over {kills['runs']} runs "
+          f"at random moments of its {kills['uninterrupted_s']:.1f} s ({kills['kills_landed']} "
+          f"before it ended), each run again to the end: {kills['survived']} of "
+          f"{kills['kills']} identical to the unkilled database, {kills['duplicates']} "
+          f"duplicates, {kills['orphans']} orphans, integrity {', '.join(kills['integrity'])}, "
+          f"{kills['foreign_key_violations']} foreign-key violations")
     backends = ["sqlite"] + (["postgresql"] if os.environ.get("SWTLAB_TEST_POSTGRES_URL")
                              else [])
     rows = [concurrent_writers(b, layout, 4 if quick else 8) for b in backends
