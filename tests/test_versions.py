@@ -71,10 +71,17 @@ def test_another_file_claiming_a_run_id_is_refused_unless_allowed(tmp_path, db_u
     assert _count(db_url, RawFile) == 1
 
     _process(tmp_path / "c", db_url, capsys, "--allow-run-id-reuse")
+    for _ in range(2):  # allowed once; the first file, still there, does not take it back
+        (row,) = _results(db_url, capsys)
+        assert (row["raw_file_path"], row["load_set_n"]) == (str(other), 300.0)
+        assert row["wheel_load_n_mean"] == pytest.approx(300.0, abs=1e-6)
+        assert row["raw_file_version"] == 2
+        _process(tmp_path / "c", db_url, capsys)
+    other.unlink()  # the run's current file gone: the first file's version is current again
+    _process(tmp_path / "c", db_url, capsys)
     (row,) = _results(db_url, capsys)
-    assert (row["raw_file_path"], row["load_set_n"]) == (str(other), 300.0)
-    assert row["wheel_load_n_mean"] == pytest.approx(300.0, abs=1e-6)
-    assert row["raw_file_version"] == 2
+    assert (row["raw_file_path"], row["load_set_n"], row["raw_file_version"]) == (
+        str(first), 180.0, 1)
 
 
 def test_reverted_file_makes_its_version_current_again(tmp_path, db_url, ingest_tools, capsys):

@@ -112,8 +112,9 @@ def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, An
 
     A run is found by its content first (a stored file moved or renamed, with or without a
     run_id, is the same run), then by (campaign, run_id). A changed file is a new version
-    and becomes current, its condition the run's; a file reverted to stored bytes makes that
-    version current again. Another file claiming a stored run_id raises
+    and becomes current, its condition the run's; the current file reverted to stored bytes
+    (or gone, with an older version's file still there) makes that version current again; an
+    old version's file lying beside the current one changes nothing. Another file claiming a stored run_id raises
     :class:`RunIdClaimed` unless ``allow_run_id_reuse``; a name the database cannot hold
     raises ``TextRefused``. ``parameters`` (channel map, derivation methods) go into the
     processing record of a new version; an unchanged file writes nothing."""
@@ -133,11 +134,12 @@ def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, An
     known = session.scalars(select(RawFile).join(Run, Run.id == RawFile.run_pk).where(
         Run.campaign_id == campaign.id, RawFile.sha256 == sha256).order_by(RawFile.id)).first()
     if known is not None:
-        _found_at(known, path)
         db_run = known.run
-        if db_run.current_version == known.version:
-            return known, StoreOutcome.UNCHANGED
-        db_run.current_version = known.version
+        current = _current(db_run)
+        _found_at(known, path)
+        if known is current or (current.path != path and Path(current.path).exists()):
+            return known, StoreOutcome.UNCHANGED  # the current one, or an old copy beside it
+        db_run.current_version = known.version  # the current file went back to these bytes
         db_run.condition_id = _condition(session, campaign, meta).id
         db_run.started_at = meta.run.started_at
         return known, StoreOutcome.REVERTED
