@@ -55,7 +55,8 @@ def store(campaign: Campaign, db_url: str, *, allow_run_id_reuse: bool = False) 
     """Store every run of ``campaign`` (processed by :func:`swtlab.process_campaign`) in the
     database at ``db_url`` (created or upgraded), one transaction per run; returns the number
     of new results. Storing again changes nothing. A file claiming the run_id of a run stored
-    from another file is refused (a ``store`` failure) unless ``allow_run_id_reuse``."""
+    from another file is refused (a ``store`` failure, added to ``campaign.failures``) unless
+    ``allow_run_id_reuse``."""
     from traceability import open_database
     from traceability.database import in_transaction
 
@@ -64,8 +65,10 @@ def store(campaign: Campaign, db_url: str, *, allow_run_id_reuse: bool = False) 
     session_factory = open_database(db_url)
     stored = 0
     for done in campaign.runs:
+        known = len(done.failures)
         stored += in_transaction(session_factory, lambda session, done=done: store_processed(
             session, done, campaign.parameters, allow_run_id_reuse=allow_run_id_reuse))
+        campaign.failures.extend(done.failures[known:])  # refused by the database
     return stored
 
 
