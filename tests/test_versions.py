@@ -131,3 +131,17 @@ def test_run_without_run_id_is_found_by_content_when_renamed(tmp_path, db_url, i
     (row,) = _results(db_url, capsys)  # once in the results, so once in every fit
     assert (row["run_id"], row["raw_file_path"]) == ("first_name", str(renamed))
     assert _count(db_url, Run) == 1 and _count(db_url, RawFile) == 1
+
+
+def test_python_store_refuses_a_claimed_run_id_as_a_failure(tmp_path, db_url, ingest_tools):
+    import swtlab
+
+    first = _write(tmp_path / "c" / "a.mcap", ingest_tools, fz_n=180.0)
+    assert swtlab.store(swtlab.process_campaign(tmp_path / "c"), db_url) == 1
+    other = _write(tmp_path / "c" / "b.mcap", ingest_tools, fz_n=300.0)
+    campaign = swtlab.process_campaign(tmp_path / "c")
+    assert swtlab.store(campaign, db_url) == 0
+    (failure,) = campaign.failures
+    assert failure.stage == "store" and failure.file == str(other)
+    assert str(first) in failure.reason and "claims run_id 'r001'" in failure.reason
+    assert list(swtlab.load(db_url).results["load_set_n"]) == [180.0]
