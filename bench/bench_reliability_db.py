@@ -117,6 +117,20 @@ def _duplicates_and_orphans(db_url: str) -> tuple[int, int]:
         return duplicates, orphans
 
 
+def _results_stored(path: Path) -> int:
+    """Results in a SQLite file a killed process left (0 where it made no schema yet)."""
+    if not path.is_file():
+        return 0
+    engine = create_engine(f"sqlite:///{path}")
+    try:
+        with engine.connect() as connection:
+            return connection.exec_driver_sql("SELECT count(*) FROM run_result").scalar()
+    except Exception:  # noqa: BLE001 - killed before the table existed
+        return 0
+    finally:
+        engine.dispose()
+
+
 def _sqlite_checks(path: Path) -> tuple[str, int]:
     engine = create_engine(f"sqlite:///{path}")
     with engine.connect() as connection:
@@ -139,7 +153,7 @@ def kill_points(kills: int, seed: int = 0) -> dict:
                        stdout=subprocess.DEVNULL, env=env)
         full_s = time.perf_counter() - start
         expected = (_content(reference), _counts(reference))
-        survived = landed = duplicates = orphans = broken_keys = 0
+        survived = landed = mid_batch = duplicates = orphans = broken_keys = 0
         integrity = set()
         for trial in range(kills):
             killed_path = Path(tmp) / f"killed{trial}.sqlite"
@@ -149,6 +163,7 @@ def kill_points(kills: int, seed: int = 0) -> dict:
             landed += process.poll() is None
             process.send_signal(signal.SIGKILL)
             process.wait(timeout=120)
+            mid_batch += 0 < _results_stored(killed_path) < len(KILL_RUNS)
             subprocess.run(_command(folder, killed), cwd=ROOT, check=True,
                            stdout=subprocess.DEVNULL, env=env)
             survived += (_content(killed), _counts(killed)) == expected
@@ -157,7 +172,8 @@ def kill_points(kills: int, seed: int = 0) -> dict:
             check, keys = _sqlite_checks(killed_path)
             integrity.add(check)
             broken_keys += keys
-    return {"kills": kills, "kills_landed": landed, "survived": survived,
+    return {"kills": kills, "kills_landed": landed, "kills_mid_batch": mid_batch,
+            "survived": survived,
             "runs": len(KILL_RUNS), "uninterrupted_s": full_s, "duplicates": duplicates,
             "orphans": orphans, "integrity": sorted(integrity),
             "foreign_key_violations": broken_keys}
@@ -213,13 +229,14 @@ def main(quick: bool = False) -> dict:
     kills = kill_points(6 if quick else 24)
     print(f"kill points: {kills['kills']} SIGKILLs of swtlab process over {kills['runs']} runs "
           f"at random moments of its {kills['uninterrupted_s']:.1f} s ({kills['kills_landed']} "
-          f"before it ended), each run again to the end: {kills['survived']} of "
+          f"before it ended, {kills['kills_mid_batch']} with some runs stored and some not), "
+          f"each run again to the end: {kills['survived']} of "
           f"{kills['kills']} identical to the unkilled database, {kills['duplicates']} "
           f"duplicates, {kills['orphans']} orphans, integrity {', '.join(kills['integrity'])}, "
           f"{kills['foreign_key_violations']} foreign-key violations")
     backends = ["sqlite"] + (["postgresql"] if os.environ.get("SWTLAB_TEST_POSTGRES_URL")
                              else [])
-    rows = [concurrent_writers(b, layout, 4 if quick else 8) for b in backends
+    rows = [concurrent_writers(b, layout, 4) for b in backends
             for layout in ("same folder", "disjoint folders")]
     print(f"{'backend':11} {'layout':17} {'writers':>7} {'runs':>5} {'crashed':>7} "
           f"{'stored once':>11} {'duplicates':>10} {'orphans':>7} {'s':>6}")
