@@ -6,6 +6,12 @@ parameters is skipped without being read). Each result is stored with its decima
 traces (``run_results.traces``), which the report draws. A run with side-camera frames
 also gets its soil flow over the stable window (``softflow.flow_run``); frames that cannot
 be analysed are reported and recorded, and the run's other results are kept.
+
+Runs are processed outside any transaction and stored under the database's write lock
+(``traceability.database``), so several ``swtlab process`` may write one database at once.
+Versions (docs/results.md): a changed file is its run's new current version, another file
+claiming a stored run_id is refused unless ``--allow-run-id-reuse``, and stored files gone
+from CAMPAIGN are marked missing.
 """
 
 from __future__ import annotations
