@@ -1,7 +1,8 @@
 """Database reliability (issue 17, item 9): kill points survived and concurrent writers.
 
 Kill points: ``swtlab process`` of a small campaign (4 sample runs) on a fresh SQLite file,
-SIGKILLed at a seeded random moment of its uninterrupted duration, then run again to the end;
+SIGKILLed once a seeded random number of runs are stored, a random part of one run's time
+later, then run again to the end;
 each such database must equal one processed without a kill (every run's version, path,
 sha256, condition, status, window and quantities), with 0 duplicates, 0 orphans and SQLite's
 integrity and foreign-key checks clean.
@@ -140,18 +141,33 @@ def _sqlite_checks(path: Path) -> tuple[str, int]:
     return integrity, broken_keys
 
 
+def _timed(process: subprocess.Popen, path: Path) -> tuple[float, float]:
+    """Seconds until the first result is in ``path`` and until ``process`` ends (exit 0)."""
+    start = time.perf_counter()
+    first_s = None
+    while process.poll() is None:
+        if first_s is None and _results_stored(path):
+            first_s = time.perf_counter() - start
+        time.sleep(0.05)
+    full_s = time.perf_counter() - start
+    if process.returncode != 0:
+        raise RuntimeError(f"swtlab process failed: {process.stderr.read()[-500:]}")
+    return (first_s or full_s), full_s
+
+
 def kill_points(kills: int, seed: int = 0) -> dict:
-    """``kills`` trials, each on a fresh SQLite file: SIGKILL at a random moment of the
-    uninterrupted duration, run again to the end, compare with an unkilled database."""
+    """``kills`` trials, each on a fresh SQLite file: SIGKILL once a random number k of runs
+    (0 .. runs - 1) are stored, a random part of one run's time later (inside reading,
+    processing or storing run k + 1), run again to the end, compare with an unkilled
+    database."""
     rng = random.Random(seed)
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     with tempfile.TemporaryDirectory() as tmp:
         folder = _campaign(Path(tmp) / "campaign", KILL_RUNS)
-        reference = f"sqlite:///{tmp}/reference.sqlite"
-        start = time.perf_counter()
-        subprocess.run(_command(folder, reference), cwd=ROOT, check=True,
-                       stdout=subprocess.DEVNULL, env=env)
-        full_s = time.perf_counter() - start
+        reference_path = Path(tmp) / "reference.sqlite"
+        reference = f"sqlite:///{reference_path}"
+        first_s, full_s = _timed(_start(folder, reference), reference_path)
+        per_run_s = max((full_s - first_s) / (len(KILL_RUNS) - 1), 0.1)
         expected = (_content(reference), _counts(reference))
         survived = landed = mid_batch = duplicates = orphans = broken_keys = 0
         integrity = set()
@@ -159,7 +175,10 @@ def kill_points(kills: int, seed: int = 0) -> dict:
             killed_path = Path(tmp) / f"killed{trial}.sqlite"
             killed = f"sqlite:///{killed_path}"
             process = _start(folder, killed)
-            time.sleep(rng.uniform(0.0, full_s))
+            after = rng.randrange(len(KILL_RUNS))  # results stored before the kill's run
+            while process.poll() is None and _results_stored(killed_path) < after:
+                time.sleep(0.02)
+            time.sleep(rng.uniform(0.0, per_run_s))
             landed += process.poll() is None
             process.send_signal(signal.SIGKILL)
             process.wait(timeout=120)
@@ -173,8 +192,8 @@ def kill_points(kills: int, seed: int = 0) -> dict:
             integrity.add(check)
             broken_keys += keys
     return {"kills": kills, "kills_landed": landed, "kills_mid_batch": mid_batch,
-            "survived": survived,
-            "runs": len(KILL_RUNS), "uninterrupted_s": full_s, "duplicates": duplicates,
+            "survived": survived, "runs": len(KILL_RUNS), "first_result_s": first_s,
+            "uninterrupted_s": full_s, "duplicates": duplicates,
             "orphans": orphans, "integrity": sorted(integrity),
             "foreign_key_violations": broken_keys}
 
@@ -228,7 +247,8 @@ def concurrent_writers(backend: str, layout: str, runs: int) -> dict:
 def main(quick: bool = False) -> dict:
     kills = kill_points(6 if quick else 24)
     print(f"kill points: {kills['kills']} SIGKILLs of swtlab process over {kills['runs']} runs "
-          f"at random moments of its {kills['uninterrupted_s']:.1f} s ({kills['kills_landed']} "
+          f"({kills['uninterrupted_s']:.1f} s uninterrupted), each after a random number of runs "
+          f"stored and a random part of the next run ({kills['kills_landed']} "
           f"before it ended, {kills['kills_mid_batch']} with some runs stored and some not), "
           f"each run again to the end: {kills['survived']} of "
           f"{kills['kills']} identical to the unkilled database, {kills['duplicates']} "
