@@ -33,10 +33,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _is_database_error(exc: Exception) -> bool:
-    """A database that cannot be used as asked (``traceability.database.DatabaseError``): the
+    """A database that cannot be used as asked (``traceability.database.UnusableDatabase``): the
     user's input, not swtlab's fault. Checked without importing the database layer."""
     database = sys.modules.get("traceability.database")
-    return database is not None and isinstance(exc, database.DatabaseError)
+    return database is not None and isinstance(exc, database.UnusableDatabase)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -3,7 +3,7 @@
 Three ways to open one: to create or upgrade it (``swtlab process``, ``swtlab migrate``), to
 write into an existing one at this swtlab's schema (``export``, ``gap``), or to read one
 (``results``, ``report``). Only the first creates a file or runs a migration; the others
-raise :class:`DatabaseError` (one line, naming the host, never the password) when the
+raise :class:`UnusableDatabase` (one line, naming the host, never the password) when the
 database is missing, unreachable, not swtlab's, or at an older schema.
 
 Writers never race: every writing transaction holds the database's one write lock
@@ -39,7 +39,7 @@ UPGRADE_COMMAND = "swtlab migrate --db URL"
 T = TypeVar("T")
 
 
-class DatabaseError(Exception):
+class UnusableDatabase(Exception):
     """A database that cannot be used as asked: missing, unreachable, refused, wrong schema."""
 
 
@@ -121,13 +121,13 @@ def _check_schema(engine: Engine, shown: str) -> None:
     if current == head:
         return
     if current is None:
-        raise DatabaseError(f"{shown}: holds no swtlab schema (create it with swtlab process "
+        raise UnusableDatabase(f"{shown}: holds no swtlab schema (create it with swtlab process "
                             f"CAMPAIGN --db URL or {UPGRADE_COMMAND})")
     known = {s.revision for s in ScriptDirectory.from_config(_config()).walk_revisions()}
     if current not in known:
-        raise DatabaseError(f"{shown}: schema revision {current} is newer than this swtlab's "
+        raise UnusableDatabase(f"{shown}: schema revision {current} is newer than this swtlab's "
                             f"{head}; upgrade swtlab to read it")
-    raise DatabaseError(f"{shown}: schema revision {current} is older than this swtlab's {head};"
+    raise UnusableDatabase(f"{shown}: schema revision {current} is older than this swtlab's {head};"
                         f" upgrade it with {UPGRADE_COMMAND} (or swtlab process, which does)")
 
 
@@ -146,11 +146,11 @@ def open_database(url: str, *, create: bool = True, read_only: bool = False
 
     ``create`` (default): create the database file and upgrade the schema to head.
     ``create=False``: the database must exist at this swtlab's schema (writes allowed).
-    ``read_only=True``: the same, without the write lock. Raises :class:`DatabaseError`."""
+    ``read_only=True``: the same, without the write lock. Raises :class:`UnusableDatabase`."""
     try:
         parsed = make_url(database_url(url))
     except ArgumentError:
-        raise DatabaseError(f"{url}: not a database URL (e.g. sqlite:///swtlab.sqlite, "
+        raise UnusableDatabase(f"{url}: not a database URL (e.g. sqlite:///swtlab.sqlite, "
                             "postgresql://user@host/db, or a plain file path)") from None
     shown = _shown(parsed)
     create = create and not read_only
@@ -159,12 +159,12 @@ def open_database(url: str, *, create: bool = True, read_only: bool = False
         if create:
             path.parent.mkdir(parents=True, exist_ok=True)
         elif not path.is_file():
-            raise DatabaseError(f"{path}: no such database file (run swtlab process CAMPAIGN "
+            raise UnusableDatabase(f"{path}: no such database file (run swtlab process CAMPAIGN "
                                 f"--db {url} first)")
     try:
         engine = _engine(parsed, writer=not read_only)
     except (ArgumentError, ImportError) as error:
-        raise DatabaseError(f"{shown}: cannot use this URL ({error})") from None
+        raise UnusableDatabase(f"{shown}: cannot use this URL ({error})") from None
     try:
         if create:
             upgrade(engine)
@@ -173,7 +173,7 @@ def open_database(url: str, *, create: bool = True, read_only: bool = False
         engine.dispose()
         where = path if path is not None else f"{parsed.host or 'localhost'}" + (
             f":{parsed.port}" if parsed.port else "")
-        raise DatabaseError(f"{shown}: cannot open the database at {where} "
+        raise UnusableDatabase(f"{shown}: cannot open the database at {where} "
                             f"({_connection_problem(error, parsed)})") from None
     return sessionmaker(engine, expire_on_commit=False)
 

@@ -114,10 +114,11 @@ def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, An
     run_id, is the same run), then by (campaign, run_id). A changed file is a new version
     and becomes current, its condition the run's; the current file reverted to stored bytes
     (or gone, with an older version's file still there) makes that version current again; an
-    old version's file lying beside the current one changes nothing. Another file claiming a stored run_id raises
-    :class:`RunIdClaimed` unless ``allow_run_id_reuse``; a name the database cannot hold
-    raises ``TextRefused``. ``parameters`` (channel map, derivation methods) go into the
-    processing record of a new version; an unchanged file writes nothing."""
+    old version's file lying beside the current one changes nothing. Another file claiming a
+    stored run_id raises :class:`RunIdClaimed` unless ``allow_run_id_reuse``; a name the
+    database cannot hold raises ``TextRefused``. ``parameters`` (channel map, derivation
+    methods) go into the processing record of a new version; an unchanged file writes
+    nothing."""
     meta = run.metadata
     path = str(Path(run.source).resolve())
     calibrations = _calibrations(meta)
