@@ -6,6 +6,12 @@ parameters is skipped without being read). Each result is stored with its decima
 traces (``run_results.traces``), which the report draws. A run with side-camera frames
 also gets its soil flow over the stable window (``softflow.flow_run``); frames that cannot
 be analysed are reported and recorded, and the run's other results are kept.
+
+Runs are processed outside any transaction and stored under the database's write lock
+(``traceability.database``), so several ``swtlab process`` may write one database at once.
+Versions (docs/results.md): a changed file is its run's new current version, another file
+claiming a stored run_id is refused unless ``--allow-run-id-reuse``, and stored files gone
+from CAMPAIGN are marked missing.
 """
 
 from __future__ import annotations
@@ -33,10 +39,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                     f"[rig_compliance] in CAMPAIGN/{CAMPAIGN_SETTINGS} or "
                     "--rig-compliance FILE (docs/run-results.md).")
     parser.add_argument("campaign", type=Path, help="folder of runs (any depth)")
-    parser.add_argument("--db", required=True, help="SQLAlchemy URL, e.g. sqlite:///swtlab.sqlite")
+    parser.add_argument("--db", required=True,
+                        help="database: SQLAlchemy URL (sqlite:///swtlab.sqlite, "
+                             "postgresql://user@host/db) or a SQLite file path; created or "
+                             "upgraded")
     parser.add_argument("--channel-map", help="TOML channel map (path or shipped name)")
     parser.add_argument("--rig-compliance", type=Path,
                         help="TOML file with a [rig_compliance] table (overrides the campaign's)")
+    parser.add_argument("--allow-run-id-reuse", action="store_true",
+                        help="store a file that claims the run_id of a run stored from another "
+                             "file as that run's new version (default: refused, naming both "
+                             "files)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.set_defaults(func=run)
 
@@ -46,7 +59,9 @@ def run(args: argparse.Namespace) -> int:
     from swtlab.pipeline.database import store_processed
     from swtlab.pipeline.process import ProcessSettings, find_runs, process_file, rig_compliance
     from traceability import open_database
+    from traceability.database import in_transaction
     from traceability.hashing import content_sha256
+    from traceability.store import mark_missing
     from traceability.store_flow import stored_flow_failure
     from traceability.store_results import params_sha256, processed_file
 
@@ -66,20 +81,26 @@ def run(args: argparse.Namespace) -> int:
     flows = up_to_date = 0
     for path in progress(paths, desc="process", quiet=args.quiet):
         sha256, _ = content_sha256(path)
-        with session_factory.begin() as session:
-            if processed_file(session, path, sha256, params_hash):
-                up_to_date += 1
-                known = stored_flow_failure(session, path, sha256, params_hash)
-                if known is not None:
-                    flow_failed.append(f"{path}: {known.channel}: {known.problem}")
-                continue
-            processed = process_file(path, settings)
-            stored = store_processed(session, processed, parameters)
+
+        def known(session, path=path, sha256=sha256):
+            if not processed_file(session, path, sha256, params_hash):
+                return None
+            failure = stored_flow_failure(session, path, sha256, params_hash)
+            return [] if failure is None else [f"{path}: {failure.channel}: {failure.problem}"]
+
+        known_flow_failures = in_transaction(session_factory, known)
+        if known_flow_failures is not None:
+            up_to_date += 1
+            flow_failed += known_flow_failures
+            continue
+        processed = process_file(path, settings)  # outside any transaction: no lock held
+        stored = in_transaction(session_factory, lambda session, p=processed: store_processed(
+            session, p, parameters, allow_run_id_reuse=args.allow_run_id_reuse))
         failed += [f.reason for f in processed.failures if f.stage != "soil_flow"]
         if processed.result is None:
             continue
         if not stored:
-            up_to_date += 1
+            up_to_date += not any(f.stage == "store" for f in processed.failures)
             continue
         result = processed.result
         flows += processed.flow is not None
@@ -88,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
         reasons = "; ".join(result.flags)
         statuses.setdefault(result.status, []).append(
             f"{result.run_id}: {reasons}" if reasons else result.run_id)
+    missing = in_transaction(session_factory, lambda session: [
+        f"{row.path} (run {row.run.run_id})" for row in mark_missing(session, args.campaign)])
     done = sum(len(v) for v in statuses.values())
     print(f"processed {done} of {len(paths)} runs ({up_to_date} already up to date): "
           f"{len(statuses['ok'])} ok, {len(statuses['flagged'])} flagged, "
@@ -97,6 +120,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {status}: {line}")
     for line in failed:
         print(f"  failed: {line}")
+    for line in missing:
+        print(f"  missing: {line}: stored, but no longer in {args.campaign}; its results stay "
+              "listed, marked raw_file_missing")
     if flows or flow_failed:
         print(f"soil flow under the wheel (side camera): measured in {flows} runs"
               + (f", not measured in {len(flow_failed)}" if flow_failed else ""))

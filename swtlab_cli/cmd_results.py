@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from swtlab_cli import exit_codes
+from swtlab.atomic import atomic_file
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
                    "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
@@ -25,7 +26,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="One row per run: identifiers and conditions, status and flags, the stable "
                     "window, and each quantity's mean, standard deviation and standard error in "
                     "SI units (columns: docs/results.md). Without --csv/--json, a summary table.")
-    parser.add_argument("--db", required=True, help="SQLAlchemy URL")
+    parser.add_argument("--db", required=True,
+                        help="database URL or SQLite file path (read, never created or upgraded)")
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")
     out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
@@ -39,12 +41,16 @@ def run(args: argparse.Namespace) -> int:
     from traceability import open_database
     from traceability.queries import latest_results
 
-    with open_database(args.db)() as session:
+    with open_database(args.db, read_only=True)() as session:
         table = latest_results(session)
     if table.empty:
         print(f"swtlab results: {args.db}: no processed runs (run swtlab process first)",
               file=sys.stderr)
         return exit_codes.BAD_INPUT
+    missing = table.loc[table["raw_file_missing"], "raw_file_path"]
+    if len(missing):
+        print(f"swtlab results: notice: the raw files of {len(missing)} runs are missing "
+              f"(marked by swtlab process): {'; '.join(missing)}", file=sys.stderr)
     if args.towed:
         from run_results import towed_vs_powered
 
@@ -53,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"swtlab results: {args.db}: no towed runs", file=sys.stderr)
             return exit_codes.BAD_INPUT
     if args.csv:
-        table.to_csv(args.csv, index=False)
+        with atomic_file(args.csv, newline="") as stream:
+            table.to_csv(stream, index=False)
         print(f"{len(table)} runs written to {args.csv}")
     elif args.json:
         print(table.to_json(orient="records", indent=1))

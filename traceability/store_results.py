@@ -12,9 +12,11 @@ from sqlalchemy.orm import Session
 
 from plain_json import jsonable
 from traceability.provenance import swtlab_version
-from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
+from traceability.models import (IngestFailure, RawFile, Run, RunQuantity, RunResult,
+                                 StableWindow)
 from traceability.store import new_processing_record
 from traceability.store_traces import store_traces
+from traceability.text import message
 
 
 def params_sha256(parameters: dict[str, Any]) -> str:
@@ -29,9 +31,11 @@ def find_result(session: Session, raw_file: RawFile, params_hash: str) -> RunRes
 
 
 def processed_file(session: Session, path: Path, sha256: str, params_hash: str) -> bool:
-    """Whether this exact file content at this path already has a result for these parameters."""
+    """Whether this exact file content at this path is its run's current version and has a
+    result for these parameters (a file reverted to an older version is not)."""
     return session.scalars(
         select(RunResult.id).join(RawFile, RawFile.id == RunResult.raw_file_id)
+        .join(Run, (Run.id == RawFile.run_pk) & (Run.current_version == RawFile.version))
         .where(RawFile.path == str(path.resolve()), RawFile.sha256 == sha256,
                RunResult.params_sha256 == params_hash)).first() is not None
 
@@ -62,7 +66,8 @@ def store_run_result(session: Session, raw_file: RawFile, result: Any,
 
 def store_ingest_failure(session: Session, path: Path, sha256: str, error: str,
                          parameters: dict[str, Any]) -> None:
-    """Record a file that could not be read (once per path, content and message)."""
+    """Record a file that could not be read or stored (once per path, content and message)."""
+    error = message(error)
     known = session.scalars(select(IngestFailure).filter_by(
         path=str(path.resolve()), sha256=sha256, error=error)).first()
     if known is None:

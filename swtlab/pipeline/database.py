@@ -9,12 +9,17 @@ from pathlib import Path
 from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
 
 
-def store_processed(session, done: ProcessedRun, parameters: dict) -> bool:
+def store_processed(session, done: ProcessedRun, parameters: dict, *,
+                    allow_run_id_reuse: bool = False) -> bool:
     """Store one processed run in ``session`` (one transaction per run, the caller's): the
     raw file, its result, its soil flow or the failures. An unchanged file already stored
-    with these parameters writes nothing; returns whether a new result was stored."""
+    with these parameters writes nothing; returns whether a new result was stored. A file
+    the database refuses (another file's run_id, a name too long) is a failure of stage
+    ``store``, recorded with its reason."""
     from softflow.flow_run import SIDE_TOPIC
     from traceability import store_ingested_run
+    from traceability.store import RunIdClaimed
+    from traceability.text import TextRefused
     from traceability.store_flow import store_flow, store_flow_failure
     from traceability.store_results import (find_result, params_sha256, store_ingest_failure,
                                             store_run_result)
@@ -24,8 +29,17 @@ def store_processed(session, done: ProcessedRun, parameters: dict) -> bool:
         for f in ingest_failures:
             store_ingest_failure(session, done.path, done.sha256, f.reason, parameters)
         return False
-    raw_file, _ = store_ingested_run(session, done.run, done.streams,
-                                     {**parameters, "derivation": done.run.derivation})
+    try:
+        with session.begin_nested():
+            raw_file, _ = store_ingested_run(session, done.run, done.streams,
+                                             {**parameters, "derivation": done.run.derivation},
+                                             allow_run_id_reuse=allow_run_id_reuse)
+    except (RunIdClaimed, TextRefused) as error:
+        failure = Failure(str(done.path), "store", str(error))
+        if failure not in done.failures:
+            done.failures.append(failure)
+        store_ingest_failure(session, done.path, done.sha256, str(error), parameters)
+        return False
     if done.result is None or find_result(session, raw_file, params_sha256(parameters)):
         return False
     stored = store_run_result(session, raw_file, done.result, parameters)
@@ -37,19 +51,24 @@ def store_processed(session, done: ProcessedRun, parameters: dict) -> bool:
     return True
 
 
-def store(campaign: Campaign, db_url: str) -> int:
+def store(campaign: Campaign, db_url: str, *, allow_run_id_reuse: bool = False) -> int:
     """Store every run of ``campaign`` (processed by :func:`swtlab.process_campaign`) in the
-    database at ``db_url``, one transaction per run; returns the number of new results.
-    Storing again changes nothing."""
+    database at ``db_url`` (created or upgraded), one transaction per run; returns the number
+    of new results. Storing again changes nothing. A file claiming the run_id of a run stored
+    from another file is refused (a ``store`` failure, added to ``campaign.failures``) unless
+    ``allow_run_id_reuse``."""
     from traceability import open_database
+    from traceability.database import in_transaction
 
     if not any(r.run is not None or r.failures for r in campaign.runs):
         raise ValueError("campaign holds no processed raw files (loaded from a database?)")
     session_factory = open_database(db_url)
     stored = 0
     for done in campaign.runs:
-        with session_factory.begin() as session:
-            stored += store_processed(session, done, campaign.parameters)
+        known = len(done.failures)
+        stored += in_transaction(session_factory, lambda session, done=done: store_processed(
+            session, done, campaign.parameters, allow_run_id_reuse=allow_run_id_reuse))
+        campaign.failures.extend(done.failures[known:])  # refused by the database
     return stored
 
 
@@ -63,7 +82,7 @@ def load(db_url: str, campaign: str | None = None) -> Campaign:
     from traceability.models import IngestFailure
     from traceability.queries import latest_results
 
-    with open_database(db_url)() as session:
+    with open_database(db_url, read_only=True)() as session:
         table = latest_results(session)
         failures = [Failure(row.path, "ingest", row.error)
                     for row in session.scalars(select(IngestFailure)).all()]
