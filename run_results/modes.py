@@ -12,8 +12,7 @@ import numpy as np
 import pandas as pd
 
 from run_results.result import RunResult
-from run_results.uncertainty_budget import budget_columns
-from swtlab.domain.results import COLUMNS, WHEEL_COLUMNS, check_results
+from swtlab.domain.results import COLUMNS, WHEEL_COLUMNS, budget_columns, check_results
 
 
 GROUP = ["wheel", "soil", "multipass", "load_set_n"]

@@ -43,8 +43,8 @@ from scipy import optimize, stats
 from run_results.native import channel_samples, hub_samples
 from run_results.rest_readings import RestReadings, resolution
 from run_results.stats import QuantityStats
+from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
 
-TERMS = ("statistical", "zero_drift", "calibration", "quantisation", "clock")
 #: quantity -> (load-cell column, divide by the wheel radius?) for the single-cell quantities
 CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),
            "thrust_n": ("ty_nm", True), "wheel_load_n": ("fz_n", False),
@@ -346,10 +346,9 @@ def with_diffusion(budgets: dict[str, QuantityBudget],
     return {k: replace(b, diffusion=diffusion) if b.drift else b for k, b in budgets.items()}
 
 
-#: results-table columns of a budget: ``<q>_<name>`` (docs/results.md)
-BUDGET_COLUMNS = ("u", "u95", "k", "dof", "correction", *(f"u_{t}" for t in TERMS))
 
-
-def budget_columns(quantity: str, budget: dict) -> dict:
-    """A budget (:meth:`QuantityBudget.to_dict`, or as stored) as results-table columns."""
-    return {f"{quantity}_{name}": budget.get(name) for name in BUDGET_COLUMNS}
+def pool_drift(results: list) -> list:
+    """``run_results.RunResult`` s of one campaign with the drift diffusion pooled over their
+    rest readings (:func:`pooled_diffusion`); the means are unchanged."""
+    diffusion = pooled_diffusion([r.corrections.get("rest_readings") for r in results])
+    return [replace(r, uncertainty=with_diffusion(r.uncertainty, diffusion)) for r in results]

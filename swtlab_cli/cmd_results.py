@@ -11,8 +11,9 @@ import pandas as pd
 from swtlab_cli import exit_codes
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
-                   "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
-                   "torque_nm_mean", "sinkage_m_mean", "resistance_n_mean", "image_slip_mean"]
+                   "window_start_s", "window_end_s", "slip_mean", "slip_u95", "dp_n_mean",
+                   "dp_n_se", "dp_n_u95", "torque_nm_mean", "torque_nm_u95", "sinkage_m_mean",
+                   "sinkage_m_u95", "resistance_n_mean", "resistance_n_u95", "image_slip_mean"]
 
 TOWED_COLUMNS = ["wheel", "soil", "multipass", "load_n", "towed_resistance_n",
                  "towed_resistance_se_n", "powered_resistance_at_zero_slip_n",
@@ -23,8 +24,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
         "results", help="list the results of every run in the database",
         description="One row per run: identifiers and conditions, status and flags, the stable "
-                    "window, and each quantity's mean, standard deviation and standard error in "
-                    "SI units (columns: docs/results.md). Without --csv/--json, a summary table.")
+                    "window, and each quantity's mean, standard deviation, standard error and "
+                    "uncertainty budget (u, u95 = k u, terms) in SI units (columns: "
+                    "docs/results.md). Without --csv/--json, a summary table.")
     parser.add_argument("--db", required=True, help="SQLAlchemy URL")
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")

@@ -6,10 +6,10 @@ import pandas as pd
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from swtlab.domain.results import COLUMNS, check_results, wheel_columns
+from swtlab.domain.results import COLUMNS, budget_columns, check_results, wheel_columns
 
-from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult, Soil,
-                                 StableWindow, TestCondition, Wheel)
+from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult,
+                                 RunUncertainty, Soil, StableWindow, TestCondition, Wheel)
 
 STATS = ("mean", "std", "se")
 
@@ -18,8 +18,8 @@ def latest_results(session: Session) -> pd.DataFrame:
     """Newest result of the newest raw-file version of every run, one row per run.
 
     Columns are documented in docs/results.md: identifiers, conditions, status and
-    flags, the stable window, ``<quantity>_mean|_std|_se`` per quantity, and the
-    grouser oscillation.
+    flags, the stable window, ``<quantity>_mean|_std|_se`` per quantity, its uncertainty
+    budget ``<quantity>_u|_u95|_k|_dof|_correction|_u_<term>``, and the grouser oscillation.
     """
     newest_file = (select(RawFile.run_pk, func.max(RawFile.version).label("version"))
                    .group_by(RawFile.run_pk).subquery())
@@ -44,6 +44,11 @@ def latest_results(session: Session) -> pd.DataFrame:
     for q in quantities:
         by_result.setdefault(q.run_result_id, {}).update(
             {f"{q.quantity}_{stat}": getattr(q, stat) for stat in STATS})
+    budgets = session.execute(select(RunUncertainty).where(
+        RunUncertainty.run_result_id.in_(result_ids))).scalars().all() if result_ids else []
+    for b in budgets:
+        by_result.setdefault(b.run_result_id, {}).update(budget_columns(b.quantity, {
+            c.key: getattr(b, c.key) for c in RunUncertainty.__table__.columns}))
     records = []
     for row in rows:
         cond, result, window = row.TestCondition, row.RunResult, row.StableWindow

@@ -12,7 +12,8 @@ from sqlalchemy.orm import Session
 
 from plain_json import jsonable
 from traceability.provenance import swtlab_version
-from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
+from traceability.models import (IngestFailure, RawFile, RunQuantity, RunResult, RunUncertainty,
+                                 StableWindow)
 from traceability.store import new_processing_record
 from traceability.store_traces import store_traces
 
@@ -57,7 +58,20 @@ def store_run_result(session: Session, raw_file: RawFile, result: Any,
     session.add(row)
     session.flush()
     store_traces(session, row, result.traces)
+    store_uncertainty(session, row, getattr(result, "uncertainty", {}))
     return row
+
+
+def store_uncertainty(session: Session, row: RunResult, budgets: dict) -> None:
+    """One ``RunUncertainty`` per quantity budget (``QuantityBudget``) of the result."""
+    for name, budget in budgets.items():
+        d = budget.to_dict()
+        session.add(RunUncertainty(
+            run_result_id=row.id, quantity=name, unit=d["unit"],
+            not_measured=list(d["not_measured"]),
+            **{k: _num(d[k]) for k in ("correction", "u_statistical", "u_zero_drift",
+                                       "u_calibration", "u_quantisation", "u_clock", "u",
+                                       "dof", "k", "u95")}))
 
 
 def store_ingest_failure(session: Session, path: Path, sha256: str, error: str,

@@ -115,9 +115,14 @@ def _process(args: tuple[Path, ProcessSettings]) -> ProcessedRun:
 
 
 def campaign_of(runs: list[ProcessedRun], parameters: dict) -> Campaign:
-    """The :class:`Campaign` of processed runs (results table of the runs with a result)."""
+    """The :class:`Campaign` of processed runs (results table of the runs with a result); the
+    load cells' drift diffusion of the uncertainty budgets is pooled over these runs."""
     from run_results import results_table
+    from run_results.uncertainty_budget import pool_drift
 
+    done = [r for r in runs if r.result is not None]
+    for r, pooled in zip(done, pool_drift([r.result for r in done])):
+        r.result = pooled
     table = results_table([r.result for r in runs if r.result is not None])
     sources = {r.result.run_id: r for r in runs if r.result is not None}
     if len(table):
