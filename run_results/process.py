@@ -26,9 +26,9 @@ from run_results.native import native_quantities
 from run_results.phase_average import phase_average
 from run_results.rest_readings import rest_readings
 from run_results.result import RunResult
-from run_results.stats import QuantityStats, quantity_stats
+from run_results.stats import QuantityStats, batch_means_se, quantity_stats
 from run_results.traces import run_traces
-from run_results.uncertainty_budget import BudgetParams, run_budget
+from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
 from swtlab.domain.results import wheel_columns
@@ -174,6 +174,13 @@ def process_run(run, params: StablePhaseParams | None = None,
         stats = quantity_stats(y[lo:hi], unit, average)
         if stats is not None:
             quantities[key] = stats
+    rate_batches = {}
+    for key in RATES:
+        if key in quantities:
+            y = series[key][0][lo:hi]
+            periodic = (phase_average(t[lo:hi], y, frequency)["periodic"]
+                        if frequency and np.isfinite(y).sum() > 16 else None)
+            rate_batches[key] = batch_means_se(y, periodic)
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     quantities.update({k: v for k, v in native.items() if k in quantities})
@@ -184,7 +191,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     rests = rest_readings(run)
     corrections["rest_readings"] = None if rests is None else rests.to_dict()
     quantities, budgets = run_budget(run, (window.start_s, window.end_s), quantities, rests,
-                                     budget)
+                                     budget, rate_batches)
     flags = (*_flags(run, window, oscillation), *image_flags)
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,
                      oscillation=oscillation, dp_trace=None, corrections=corrections,

@@ -4,7 +4,10 @@ combination, the effective degrees of freedom and the 95 % expanded uncertainty.
 Terms (standard uncertainties in the quantity's unit, each with its degrees of freedom):
 
 - ``statistical``: the window's autocorrelation-corrected SE (``run_results.stats``),
-  ``nu = n_eff - 1`` (Type A, GUM 4.2).
+  ``nu = n_eff - 1`` (Type A, GUM 4.2). For the rates derived from encoder positions (slip,
+  travel velocity, wheel speed) the larger of that and the batch-means SE (``B - 1``
+  degrees of freedom): the derivative filter's noise is anti-correlated at short lags, which
+  ends the autocorrelation sum before a slow ripple of the drives is seen.
 - ``zero_drift``: the load cells' zero at the window, from the rest readings
   (``run_results.rest_readings``). DP, torque and side force read zero at rest, ``fz`` the
   set load (raw-run spec); the zero is taken as linear in time between the two rests and
@@ -53,6 +56,8 @@ CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),
 FIELD_OF = {"dp_n": ("/tether/force", "dp"), "ty_nm": ("/hub/wrench", "ty"),
             "fz_n": ("/hub/wrench", "fz"), "fy_n": ("/hub/wrench", "fy")}
 SPEEDS = ("travel_velocity_mps", "wheel_omega_radps")
+#: rates derived from encoder positions (their statistical term also by batch means)
+RATES = ("slip", *SPEEDS)
 INF = math.inf
 
 
@@ -278,22 +283,30 @@ def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> 
                           missing, drift)
 
 
-def _speed_budget(s: QuantityStats, params: BudgetParams) -> dict:
+def _rate_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
+    """The larger of the autocorrelation and the batch-means statistical terms."""
+    term = _statistical(s)
+    return term if batch is None or batch[0] <= term.u else Term(*batch)
+
+
+def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
     """Statistics and the clock (the encoders' resolution, a step over the whole window,
     is far below both)."""
-    terms = {"statistical": _statistical(s),
+    terms = {"statistical": _rate_statistical(s, batch),
              "clock": Term(abs(s.mean) * params.clock_rate_bound_ppm * 1e-6 / math.sqrt(3),
                            rectangular=True)}
     return terms
 
 
 def run_budget(run, window_s: tuple[float, float], quantities: dict[str, QuantityStats],
-               rests: RestReadings | None,
-               params: BudgetParams | None = None) -> tuple[dict[str, QuantityStats],
-                                                            dict[str, QuantityBudget]]:
+               rests: RestReadings | None, params: BudgetParams | None = None,
+               batches: dict | None = None) -> tuple[dict[str, QuantityStats],
+                                                     dict[str, QuantityBudget]]:
     """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
-    re-zeroing correction added (module doc)."""
+    re-zeroing correction added (module doc); ``batches``: the rates' batch-means
+    ``(se, dof)`` (``run_results.stats.batch_means_se``)."""
     params = params or BudgetParams()
+    batches = batches or {}
     budgets: dict[str, QuantityBudget] = {}
     for key, s in quantities.items():
         if key in CELL_OF:
@@ -308,11 +321,13 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
     for key in SPEEDS:
         if key in quantities:
             budgets[key] = QuantityBudget(quantities[key].unit, 0.0,
-                                          _speed_budget(quantities[key], params))
+                                          _speed_budget(quantities[key], params,
+                                                        batches.get(key)))
     if "slip" in quantities:
         s = quantities["slip"]
         clock = (1 - min(abs(s.mean), 1.0)) * math.sqrt(2) * params.clock_rate_bound_ppm * 1e-6
-        budgets["slip"] = QuantityBudget(s.unit, 0.0, {"statistical": _statistical(s),
+        budgets["slip"] = QuantityBudget(s.unit, 0.0, {"statistical": _rate_statistical(
+                                                            s, batches.get("slip")),
                                                        "clock": Term(clock / math.sqrt(3))})
     for key, s in quantities.items():
         budgets.setdefault(key, QuantityBudget(s.unit, 0.0, {"statistical": _statistical(s)},
