@@ -75,10 +75,11 @@ def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, flo
     the batch means, Newey & West 1987, Econometrica 55(3) 703, one lag at full weight):
     ``se^2 = (c0 + 2 c1) / B`` on ``B - 2`` degrees of freedom, on ``y`` less its ``periodic``
     part (the phase-averaged grouser wave) where given. The lag-1 term takes out what one
-    batch's end shares with the next: the telescoping noise of a rate derived from positions
-    (which plain batch means overstate ``B`` times) and a correlation spilling over one batch;
-    so it sees a drive's slow ripple that ends a summed autocorrelation early. None with fewer
-    than 4 finite samples per batch or a negative estimate."""
+    batch's end shares with the next: the telescoping noise of a rate derived from noisy
+    positions (which plain batch means overstate ``sqrt(B)`` times) and a correlation
+    spilling over one batch; so it sees a drive's slow ripple that ends a summed
+    autocorrelation early. None with fewer than 4 finite samples per batch or a negative
+    estimate."""
     y = np.asarray(y, float)
     if periodic is not None:
         y = y - np.nan_to_num(np.asarray(periodic, float))
