@@ -191,7 +191,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     rests = rest_readings(run)
     corrections["rest_readings"] = None if rests is None else rests.to_dict()
     quantities, budgets = run_budget(run, (window.start_s, window.end_s), quantities, rests,
-                                     budget, rate_batches)
+                                     budget, rate_batches, frequency)
     flags = (*_flags(run, window, oscillation), *image_flags)
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,
                      oscillation=oscillation, dp_trace=None, corrections=corrections,

@@ -5,9 +5,11 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
 
 - ``statistical``: the window's autocorrelation-corrected SE (``run_results.stats``),
   ``nu = n_eff - 1`` (Type A, GUM 4.2). For the rates derived from encoder positions (slip,
-  travel velocity, wheel speed) the larger of that and the batch-means SE (``B - 1``
-  degrees of freedom): the derivative filter's noise is anti-correlated at short lags, which
-  ends the autocorrelation sum before a slow ripple of the drives is seen.
+  travel velocity, wheel speed) the batch-means SE with its lag-1 autocovariance
+  (``run_results.stats.batch_means_se``, ``B - 2`` degrees of freedom) instead: the
+  derivative filter's noise is anti-correlated at short lags, so the autocorrelation sum,
+  which stops at the first negative pair, counts that noise in full and still ends before
+  a slow ripple of the drives is seen.
 - ``zero_drift``: the load cells' zero at the window, from the rest readings
   (``run_results.rest_readings``). DP, torque and side force read zero at rest, ``fz`` the
   set load (raw-run spec); the zero is taken as linear in time between the two rests and
@@ -26,6 +28,10 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   ``exp(-2 pi^2 s^2 / q^2)`` for samples spread by ``s`` (dithered by their own noise: the
   first harmonic of the quantiser's mean error for Gaussian input, Widrow, Kollar & Liu 1996,
   IEEE Trans. Instrum. Meas. 45(2) 353); load cells and the suspension arm.
+- ``phase_sampling``: a sensor sampling a sharp-edged grouser wave only ``m`` times a period
+  sees few of its phases; the rectangle rule over a period errs by at most ``drop / (2 m)``
+  for a jump ``drop`` (the largest step between adjacent phase bins of the waveform), a
+  bound taken as rectangular (GUM 4.3.7). Load cells and the suspension arm, with grousers.
 - ``clock``: the loggers' rate error, rectangular within ``+-clock_rate_bound_ppm`` (the
   logger's stated clock tolerance), relative on speeds, ``(1 - |s|) sqrt(2) u`` on slip (the
   wheel and sled encoders' clocks apart).
@@ -41,9 +47,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+import numpy as np
 from scipy import optimize, stats
 
-from run_results.native import channel_samples, hub_samples
+from run_results.native import MIN_SAMPLES_PER_BIN, channel_samples, hub_samples
+from run_results.phase_average import phase_average
 from run_results.rest_readings import RestReadings, resolution
 from run_results.stats import QuantityStats
 from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
@@ -66,6 +74,10 @@ class BudgetParams:
     """What the budget is told about the rig: the loggers' clock tolerance (ppm, bound)."""
 
     clock_rate_bound_ppm: float = 100.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.clock_rate_bound_ppm) and self.clock_rate_bound_ppm >= 0):
+            raise ValueError(f"clock_rate_bound_ppm {self.clock_rate_bound_ppm} must be >= 0")
 
     def to_dict(self) -> dict:
         return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm}
@@ -242,11 +254,28 @@ def _quantisation(q: float, spread: float) -> float:
     return q / math.sqrt(12) * math.exp(-2 * math.pi**2 * (spread / q) ** 2)
 
 
+def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -> Term | None:
+    """Bound ``drop / (2 m)`` on the window mean of a periodic wave sampled ``m`` times a
+    period (module doc), as a rectangular term; None without a frequency or samples."""
+    if not frequency_hz or y.size < 2:
+        return None
+    average = phase_average(t_s, y, frequency_hz)
+    if y.size < MIN_SAMPLES_PER_BIN * average["bins"]:
+        return None
+    wave = average["waveform"][np.isfinite(average["waveform"])]
+    if wave.size < 2:
+        return None
+    drop = float(np.max(np.abs(np.diff(np.append(wave, wave[0])))))
+    per_period = 1.0 / (frequency_hz * float(np.median(np.diff(t_s))))
+    return Term(drop / (2.0 * per_period) / math.sqrt(3.0), rectangular=True)
+
+
 def _statistical(s: QuantityStats) -> Term:
     return Term(float(s.se), max(float(s.n_eff) - 1.0, 1.0))
 
 
-def _cell_budget(run, rests, window_s, key: str, s: QuantityStats) -> QuantityBudget:
+def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
+                 frequency_hz: float | None) -> QuantityBudget:
     """Budget of a single-cell quantity (thrust: the torque cell over the radius)."""
     column, per_radius = CELL_OF[key]
     scale = run.metadata.wheel.radius_m if per_radius else 1.0
@@ -266,13 +295,16 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats) -> QuantityBu
     native = channel_samples(run, column, *window_s)
     if native is not None:
         terms["quantisation"] = Term(_quantisation(resolution(native[1]) / scale, s.std))
+        sampling = phase_sampling(native[0], native[1] / scale, frequency_hz)
+        if sampling is not None:
+            terms["phase_sampling"] = sampling
     return QuantityBudget(s.unit, -z.zero / scale, terms, tuple(missing), drift)
 
 
 def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> QuantityBudget:
     """Budget of ``sum(sign * part)`` with its own statistical term (cells independent)."""
     terms = {"statistical": _statistical(s)}
-    for name in ("calibration", "quantisation"):
+    for name in ("calibration", "quantisation", "phase_sampling"):
         found = [Term(abs(sign) * b.terms[name].u, b.terms[name].dof) for b, sign in parts
                  if name in b.terms]
         if found:
@@ -284,9 +316,8 @@ def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> 
 
 
 def _rate_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
-    """The larger of the autocorrelation and the batch-means statistical terms."""
-    term = _statistical(s)
-    return term if batch is None or batch[0] <= term.u else Term(*batch)
+    """The batch-means statistical term, the autocorrelation one where it has none."""
+    return _statistical(s) if batch is None else Term(*batch)
 
 
 def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
@@ -300,24 +331,27 @@ def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
 
 def run_budget(run, window_s: tuple[float, float], quantities: dict[str, QuantityStats],
                rests: RestReadings | None, params: BudgetParams | None = None,
-               batches: dict | None = None) -> tuple[dict[str, QuantityStats],
-                                                     dict[str, QuantityBudget]]:
+               batches: dict | None = None,
+               frequency_hz: float | None = None) -> tuple[dict[str, QuantityStats],
+                                                           dict[str, QuantityBudget]]:
     """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
     re-zeroing correction added (module doc); ``batches``: the rates' batch-means
-    ``(se, dof)`` (``run_results.stats.batch_means_se``)."""
+    ``(se, dof)`` (``run_results.stats.batch_means_se``); ``frequency_hz``: the grouser
+    passing frequency (None: no grousers)."""
     params = params or BudgetParams()
     batches = batches or {}
     budgets: dict[str, QuantityBudget] = {}
     for key, s in quantities.items():
         if key in CELL_OF:
-            budgets[key] = _cell_budget(run, rests, window_s, key, s)
+            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz)
     if "resistance_n" in quantities and "thrust_n" in budgets and "dp_n" in budgets:
         budgets["resistance_n"] = _sum_budget(quantities["resistance_n"],
                                               [(budgets["thrust_n"], 1.0),
                                                (budgets["dp_n"], -1.0)])
     for key in ("hub_height_m", "sinkage_m"):
         if key in quantities:
-            budgets[key] = _height_budget(run, key, quantities[key], window_s, budgets)
+            budgets[key] = _height_budget(run, key, quantities[key], window_s, budgets,
+                                          frequency_hz)
     for key in SPEEDS:
         if key in quantities:
             budgets[key] = QuantityBudget(quantities[key].unit, 0.0,
@@ -337,13 +371,17 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
     return corrected, budgets
 
 
-def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict) -> QuantityBudget:
+def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict,
+                   frequency_hz: float | None) -> QuantityBudget:
     """Hub height: statistics and the arm encoder's quantisation; sinkage of a flexible wheel
     also the wheel load's zero and calibration through ``fz / (1000 k)``."""
     terms = {"statistical": _statistical(s)}
     hub = hub_samples(run, *window_s)
     if hub is not None:
         terms["quantisation"] = Term(_quantisation(resolution(hub[1]), s.std))
+        sampling = phase_sampling(hub[0], hub[1], frequency_hz)
+        if sampling is not None:
+            terms["phase_sampling"] = sampling
     stiffness = run.metadata.wheel.stiffness_n_per_mm
     if key == "hub_height_m" or stiffness is None or "wheel_load_n" not in budgets:
         return QuantityBudget(s.unit, 0.0, terms)

@@ -400,6 +400,7 @@ class RunUncertainty(Base):
     u_zero_drift: Mapped[float | None] = mapped_column(Float, nullable=True)
     u_calibration: Mapped[float | None] = mapped_column(Float, nullable=True)
     u_quantisation: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_phase_sampling: Mapped[float | None] = mapped_column(Float, nullable=True)
     u_clock: Mapped[float | None] = mapped_column(Float, nullable=True)
     u: Mapped[float | None] = mapped_column(Float, nullable=True)
     dof: Mapped[float | None] = mapped_column(Float, nullable=True)

@@ -25,6 +25,7 @@ def upgrade() -> None:
     sa.Column('u_zero_drift', sa.Float(), nullable=True),
     sa.Column('u_calibration', sa.Float(), nullable=True),
     sa.Column('u_quantisation', sa.Float(), nullable=True),
+    sa.Column('u_phase_sampling', sa.Float(), nullable=True),
     sa.Column('u_clock', sa.Float(), nullable=True),
     sa.Column('u', sa.Float(), nullable=True),
     sa.Column('dof', sa.Float(), nullable=True),
