@@ -15,6 +15,9 @@ SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint",
                    "dp_n_se", "dp_n_u95", "torque_nm_mean", "torque_nm_u95", "sinkage_m_mean",
                    "sinkage_m_u95", "resistance_n_mean", "resistance_n_u95", "image_slip_mean"]
 
+REPLICATE_COLUMNS = ["wheel", "mode", "multipass", "load_set_n", "slip_setpoint", "quantity",
+                     "runs", "mean", "replicate_sd", "within_u", "ratio", "larger"]
+
 TOWED_COLUMNS = ["wheel", "soil", "multipass", "load_n", "towed_resistance_n",
                  "towed_resistance_se_n", "powered_resistance_at_zero_slip_n",
                  "powered_resistance_se_n", "powered_method", "difference_n"]
@@ -31,9 +34,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")
     out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
-    parser.add_argument("--towed", action="store_true",
-                        help="instead: motion resistance of the towed runs against powered runs "
-                             "at zero slip, per wheel, soil, multipass and load")
+    instead = parser.add_mutually_exclusive_group()
+    instead.add_argument("--towed", action="store_true",
+                         help="instead: motion resistance of the towed runs against powered runs "
+                              "at zero slip, per wheel, soil, multipass and load")
+    instead.add_argument("--replicates", action="store_true",
+                         help="instead: the spread of replicate runs (same condition) beside "
+                              "their within-run uncertainty, per condition and quantity")
     parser.set_defaults(func=run)
 
 
@@ -54,6 +61,14 @@ def run(args: argparse.Namespace) -> int:
         if table.empty:
             print(f"swtlab results: {args.db}: no towed runs", file=sys.stderr)
             return exit_codes.BAD_INPUT
+    if args.replicates:
+        from swtlab.domain.replicates import NO_REPLICATES, replicate_spread
+
+        table = replicate_spread(table)
+        if table.empty:
+            print(f"swtlab results: {args.db}: {NO_REPLICATES}")
+            return exit_codes.OK
+        table = table.assign(run_ids=table["run_ids"].map(" ".join))
     if args.csv:
         table.to_csv(args.csv, index=False)
         print(f"{len(table)} runs written to {args.csv}")
@@ -61,6 +76,9 @@ def run(args: argparse.Namespace) -> int:
         print(table.to_json(orient="records", indent=1))
     elif args.towed:
         print(table[TOWED_COLUMNS].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    elif args.replicates:
+        columns = [c for c in REPLICATE_COLUMNS if c in table.columns]
+        print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     else:
         columns = [c for c in SUMMARY_COLUMNS if c in table.columns]
         print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
