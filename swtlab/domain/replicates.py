@@ -29,9 +29,12 @@ def _within_u(table: pd.DataFrame, quantity: str) -> pd.Series:
 
 
 def _groups(table: pd.DataFrame):
+    """The runs with a stable phase grouped by condition; None when the table lacks a column
+    of :data:`REPLICATE_KEY` (then no two runs can be told to be replicates)."""
+    if any(c not in table for c in REPLICATE_KEY):
+        return None
     usable = table[table["status"] != "no_stable_phase"] if "status" in table else table
-    key = [c for c in REPLICATE_KEY if c in usable]
-    return usable.groupby(key, dropna=False, sort=True), key
+    return usable.groupby(list(REPLICATE_KEY), dropna=False, sort=True)
 
 
 def replicate_spread(table: pd.DataFrame, quantities=QUANTITIES) -> pd.DataFrame:
@@ -40,9 +43,9 @@ def replicate_spread(table: pd.DataFrame, quantities=QUANTITIES) -> pd.DataFrame
     standard deviation), ``within_u`` (RMS of the runs' own uncertainties), ``ratio``
     (``replicate_sd / within_u``: about 1 when the budget holds what varies between runs) and
     ``larger`` (``replicates`` or ``within_run``). Empty: no replicates (:data:`NO_REPLICATES`)."""
-    groups, key = _groups(table)
+    groups, key = _groups(table), list(REPLICATE_KEY)
     rows = []
-    for values, group in groups:
+    for values, group in groups if groups is not None else ():
         if len(group) < 2:
             continue
         for q in quantities:
@@ -54,7 +57,7 @@ def replicate_spread(table: pd.DataFrame, quantities=QUANTITIES) -> pd.DataFrame
                 continue
             sd = float(means[ok].std(ddof=1))
             within = float(np.sqrt(np.nanmean(_within_u(group, q)[ok] ** 2)))
-            rows.append({**dict(zip(key, values if isinstance(values, tuple) else (values,))),
+            rows.append({**dict(zip(key, values)),
                          "quantity": q, "runs": int(ok.sum()),
                          "run_ids": list(group.loc[ok, "run_id"]), "mean": float(means[ok].mean()),
                          "replicate_sd": sd, "within_u": within,
@@ -69,9 +72,9 @@ def fit_sigma(table: pd.DataFrame, quantity: str) -> pd.Series:
     """Each run's sigma for a fit: the larger of its own uncertainty and the replicate spread
     of its condition (the own uncertainty where the condition has no replicate)."""
     within = _within_u(table, quantity)
-    if f"{quantity}_mean" not in table:
+    groups = _groups(table)
+    if f"{quantity}_mean" not in table or groups is None:
         return within
-    groups, _ = _groups(table)
     spread = groups[f"{quantity}_mean"].transform(lambda m: m.astype(float).std(ddof=1))
     spread = spread.reindex(table.index)
     return pd.concat([within, spread], axis=1).max(axis=1, skipna=True).where(within.notna()
