@@ -81,3 +81,12 @@ def test_replicates_recognised_and_consistent_with_the_budget(replicated, tmp_pa
     rows = json.loads(listing.getvalue())
     assert {r["quantity"] for r in rows} >= {"dp_n", "torque_nm", "sinkage_m", "slip"}
     assert all(r["runs"] == 6 for r in rows)
+    # swtlab process pooled the drift over the runs it stored, as process_campaign does
+    with contextlib.redirect_stdout(io.StringIO()) as listing:
+        assert swtlab_main(["results", "--db", url, "--json"]) == 0
+    stored = pd.DataFrame(json.loads(listing.getvalue())).set_index("run_id")
+    api = campaign.results.set_index("run_id")
+    for q in ("dp_n", "wheel_load_n", "resistance_n"):
+        assert stored[f"{q}_u"].to_numpy() == pytest.approx(api.loc[stored.index, f"{q}_u"]
+                                                            .to_numpy(), rel=1e-9)
+        assert (stored[f"{q}_dof"].dropna() > 5).all()   # pooled: many degrees of freedom
