@@ -90,3 +90,17 @@ def test_replicates_recognised_and_consistent_with_the_budget(replicated, tmp_pa
         assert stored[f"{q}_u"].to_numpy() == pytest.approx(api.loc[stored.index, f"{q}_u"]
                                                             .to_numpy(), rel=1e-9)
         assert (stored[f"{q}_dof"].dropna() > 5).all()   # pooled: many degrees of freedom
+
+
+def test_the_report_shows_the_replicate_spread_or_says_there_is_none(replicated):
+    from campaign_report.data import from_results
+    from campaign_report.replicates import replicates_section
+
+    campaign = swtlab.process_campaign(replicated, soil_flow=False)
+    results = [r.result for r in campaign.runs]
+    section = replicates_section(from_results("virtual", results), None)
+    table = section.blocks[1]
+    assert len(table.rows) == len(campaign.replicates)
+    assert {row[5] for row in table.rows} == {"6"}           # six runs per condition
+    alone = replicates_section(from_results("virtual", results[:1] + results[-1:]), None)
+    assert "no replicate runs" in alone.blocks[0].text and alone.blocks[0].warning
