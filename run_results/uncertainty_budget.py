@@ -64,6 +64,8 @@ CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),
 FIELD_OF = {"dp_n": ("/tether/force", "dp"), "ty_nm": ("/hub/wrench", "ty"),
             "fz_n": ("/hub/wrench", "fz"), "fy_n": ("/hub/wrench", "fy")}
 SPEEDS = ("travel_velocity_mps", "wheel_omega_radps")
+#: the loggers' clock tolerance assumed where none is stated (a common quartz class)
+DEFAULT_CLOCK_PPM = 100.0
 #: rates derived from encoder positions (their statistical term also by batch means)
 RATES = ("slip", *SPEEDS)
 INF = math.inf
@@ -71,13 +73,25 @@ INF = math.inf
 
 @dataclass(frozen=True)
 class BudgetParams:
-    """What the budget is told about the rig: the loggers' clock tolerance (ppm, bound)."""
+    """What the budget is told about the rig: the loggers' clock tolerance (ppm, bound; None:
+    not stated, :data:`DEFAULT_CLOCK_PPM` is used and the budget says so)."""
 
-    clock_rate_bound_ppm: float = 100.0
+    clock_rate_bound_ppm: float | None = None
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.clock_rate_bound_ppm) and self.clock_rate_bound_ppm >= 0):
-            raise ValueError(f"clock_rate_bound_ppm {self.clock_rate_bound_ppm} must be >= 0")
+        ppm = self.clock_rate_bound_ppm
+        if ppm is not None and not (math.isfinite(ppm) and ppm >= 0):
+            raise ValueError(f"clock_rate_bound_ppm {ppm} must be >= 0")
+
+    @property
+    def clock_ppm(self) -> float:
+        return DEFAULT_CLOCK_PPM if self.clock_rate_bound_ppm is None else self.clock_rate_bound_ppm
+
+    @property
+    def clock_missing(self) -> tuple[str, ...]:
+        return () if self.clock_rate_bound_ppm is not None else (
+            f"clock tolerance (not stated in swtlab.toml [uncertainty]: {DEFAULT_CLOCK_PPM:g} "
+            "ppm assumed)",)
 
     def to_dict(self) -> dict:
         return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm}
@@ -324,7 +338,7 @@ def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
     """Statistics and the clock (the encoders' resolution, a step over the whole window,
     is far below both)."""
     terms = {"statistical": _rate_statistical(s, batch),
-             "clock": Term(abs(s.mean) * params.clock_rate_bound_ppm * 1e-6 / math.sqrt(3),
+             "clock": Term(abs(s.mean) * params.clock_ppm * 1e-6 / math.sqrt(3),
                            rectangular=True)}
     return terms
 
@@ -356,13 +370,14 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
         if key in quantities:
             budgets[key] = QuantityBudget(quantities[key].unit, 0.0,
                                           _speed_budget(quantities[key], params,
-                                                        batches.get(key)))
+                                                        batches.get(key)), params.clock_missing)
     if "slip" in quantities:
         s = quantities["slip"]
-        clock = (1 - min(abs(s.mean), 1.0)) * math.sqrt(2) * params.clock_rate_bound_ppm * 1e-6
+        clock = (1 - min(abs(s.mean), 1.0)) * math.sqrt(2) * params.clock_ppm * 1e-6
         budgets["slip"] = QuantityBudget(s.unit, 0.0, {"statistical": _rate_statistical(
                                                             s, batches.get("slip")),
-                                                       "clock": Term(clock / math.sqrt(3))})
+                                                       "clock": Term(clock / math.sqrt(3))},
+                                         params.clock_missing)
     for key, s in quantities.items():
         budgets.setdefault(key, QuantityBudget(s.unit, 0.0, {"statistical": _statistical(s)},
                                                ("only the window statistics",)))
@@ -401,7 +416,14 @@ def with_diffusion(budgets: dict[str, QuantityBudget],
 
 
 def pool_drift(results: list) -> list:
-    """``run_results.RunResult`` s of one campaign with the drift diffusion pooled over their
-    rest readings (:func:`pooled_diffusion`); the means are unchanged."""
-    diffusion = pooled_diffusion([r.corrections.get("rest_readings") for r in results])
-    return [replace(r, uncertainty=with_diffusion(r.uncertainty, diffusion)) for r in results]
+    """``run_results.RunResult`` s with the drift diffusion pooled over the rest readings of
+    the runs of each campaign (``condition["campaign"]``, one rig's cells;
+    :func:`pooled_diffusion`); the means are unchanged."""
+    campaigns: dict = {}
+    for r in results:
+        campaigns.setdefault(r.condition.get("campaign"), []).append(
+            r.corrections.get("rest_readings"))
+    diffusion = {c: pooled_diffusion(records) for c, records in campaigns.items()}
+    return [replace(r, uncertainty=with_diffusion(r.uncertainty,
+                                                  diffusion[r.condition.get("campaign")]))
+            for r in results]

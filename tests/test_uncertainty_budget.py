@@ -144,3 +144,12 @@ def test_pooled_diffusion_of_random_walk_drifts():
                         "after": {"dp_n": {"t_s": 46.5, "mean": d, "se": 0.01}}})
     pooled = pooled_diffusion([*records, None])
     assert pooled["dp_n"].u == pytest.approx(0.05, rel=0.15) and pooled["dp_n"].dof == 400
+
+
+def test_an_unstated_clock_is_said_to_be_assumed():
+    from run_results.uncertainty_budget import DEFAULT_CLOCK_PPM, BudgetParams
+
+    assert BudgetParams().clock_ppm == DEFAULT_CLOCK_PPM and BudgetParams().clock_missing
+    assert BudgetParams(150.0).clock_ppm == 150.0 and BudgetParams(150.0).clock_missing == ()
+    with pytest.raises(ValueError, match="must be >= 0"):
+        BudgetParams(-1.0)

@@ -67,7 +67,7 @@ def rig_compliance(folder: Path, path: Path | None = None):
 
 def budget_params(folder: Path):
     """The ``[uncertainty]`` of ``folder/swtlab.toml`` (``clock_rate_bound_ppm``: the loggers'
-    stated clock tolerance) as ``BudgetParams``; the defaults without the file or table."""
+    stated clock tolerance) as ``BudgetParams``; nothing stated without the file or table."""
     from run_results.uncertainty_budget import BudgetParams
 
     source = Path(folder) / CAMPAIGN_SETTINGS
