@@ -57,6 +57,8 @@ class RunRecord:
     dp_trace: dict | None
     traces: dict[str, Trace] | None  # None: not stored (processed before migration 0006)
     means: dict[str, float] = field(default_factory=dict)
+    #: quantity -> 95 % expanded uncertainty of the mean (the run's budget)
+    u95: dict[str, float] = field(default_factory=dict)
 
     @classmethod
     def from_result(cls, result: ProcessedRun) -> RunRecord:
@@ -71,7 +73,9 @@ class RunRecord:
                    window_end_s=_none_if_nan(w.end_s) if w.found else None,
                    dp_trace=result.dp_trace, traces=dict(result.traces),
                    means={k: float(q.mean) for k, q in result.quantities.items()
-                          if _none_if_nan(q.mean) is not None})
+                          if _none_if_nan(q.mean) is not None},
+                   u95={k: float(b.u95) for k, b in result.uncertainty.items()
+                        if _none_if_nan(b.u95) is not None})
 
 
 @dataclass(frozen=True)
@@ -171,7 +175,9 @@ def _run_records(session: Session, results: pd.DataFrame) -> list[RunRecord]:
             window_end_s=_none_if_nan(row["window_end_s"]), dp_trace=more.dp_trace,
             traces=traces.get(int(row["result_id"])),
             means={c.removesuffix("_mean"): v for c in means
-                   if (v := _none_if_nan(row[c])) is not None}))
+                   if (v := _none_if_nan(row[c])) is not None},
+            u95={c.removesuffix("_u95"): v for c in row
+                 if c.endswith("_u95") and (v := _none_if_nan(row[c])) is not None}))
     return runs
 
 

@@ -24,9 +24,11 @@ from run_results import oscillation as osc
 from run_results.corrections import RigCompliance, corrected_heights, tare_record
 from run_results.native import native_quantities
 from run_results.phase_average import phase_average
+from run_results.rest_readings import rest_readings
 from run_results.result import RunResult
-from run_results.stats import QuantityStats, quantity_stats
+from run_results.stats import QuantityStats, batch_means_se, quantity_stats
 from run_results.traces import run_traces
+from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
 from swtlab.domain.results import wheel_columns
@@ -138,10 +140,13 @@ def _image_slip(image) -> tuple[dict[str, QuantityStats], list[str]]:
 
 
 def process_run(run, params: StablePhaseParams | None = None,
-                rig: RigCompliance | None = None, image_slip=None) -> RunResult:
+                rig: RigCompliance | None = None, image_slip=None,
+                budget: BudgetParams | None = None) -> RunResult:
     """Stable window, corrected quantities with honest SE, oscillation and flags of one run;
     ``image_slip``, the run's track photos as measured (``softflow.track_run.run_image_slip``,
-    which the pipeline calls), is reported beside the encoder slip."""
+    which the pipeline calls), is reported beside the encoder slip. Every quantity has an
+    uncertainty budget (``run_results.uncertainty_budget``, told the rig's clock by
+    ``budget``); its mean carries the budget's re-zeroing on the rest readings."""
     window = detect_stable_phase(run, params)
     image_quantities, image_flags = _image_slip(image_slip)
     series, applied = _series(run, rig)
@@ -169,6 +174,13 @@ def process_run(run, params: StablePhaseParams | None = None,
         stats = quantity_stats(y[lo:hi], unit, average)
         if stats is not None:
             quantities[key] = stats
+    rate_batches = {}
+    for key in RATES:
+        if key in quantities:
+            y = series[key][0][lo:hi]
+            periodic = (phase_average(t[lo:hi], y, frequency)["periodic"]
+                        if frequency and np.isfinite(y).sum() > 16 else None)
+            rate_batches[key] = batch_means_se(y, periodic)
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     quantities.update({k: v for k, v in native.items() if k in quantities})
@@ -176,6 +188,11 @@ def process_run(run, params: StablePhaseParams | None = None,
                        if k in quantities})
     corrections["hub_height_correction_mean_m"] = float(np.nanmean(applied["correction_m"][lo:hi]))
     quantities.update(image_quantities)
+    rests = rest_readings(run)
+    corrections["rest_readings"] = None if rests is None else rests.to_dict()
+    quantities, budgets = run_budget(run, (window.start_s, window.end_s), quantities, rests,
+                                     budget, rate_batches, frequency)
     flags = (*_flags(run, window, oscillation), *image_flags)
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,
-                     oscillation=oscillation, dp_trace=None, corrections=corrections, **common)
+                     oscillation=oscillation, dp_trace=None, corrections=corrections,
+                     uncertainty=budgets, **common)

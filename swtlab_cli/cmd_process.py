@@ -57,18 +57,21 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import ingest
     from swtlab.pipeline.database import store_processed
-    from swtlab.pipeline.process import ProcessSettings, find_runs, process_file, rig_compliance
+    from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
+                                         process_file, rig_compliance)
     from traceability import open_database
     from traceability.database import in_transaction
     from traceability.hashing import content_sha256
     from traceability.store import mark_missing
     from traceability.store_flow import stored_flow_failure
-    from traceability.store_results import params_sha256, processed_file
+    from traceability.store_results import params_sha256, processed_file, replace_uncertainty
+    from run_results.uncertainty_budget import pool_drift
 
     try:
         paths = find_runs(args.campaign, args.channel_map)
         settings = ProcessSettings(channel_map=args.channel_map,
-                                   rig=rig_compliance(args.campaign, args.rig_compliance))
+                                   rig=rig_compliance(args.campaign, args.rig_compliance),
+                                   budget=budget_params(args.campaign))
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
         print(f"swtlab process: {error}", file=sys.stderr)
         return exit_codes.BAD_INPUT
@@ -79,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
     failed: list[str] = []
     flow_failed: list[str] = []
     flows = up_to_date = 0
+    new: list[tuple] = []   # (path, sha256, result) stored now: their drift is pooled below
     for path in progress(paths, desc="process", quiet=args.quiet):
         sha256, _ = content_sha256(path)
 
@@ -103,6 +107,7 @@ def run(args: argparse.Namespace) -> int:
             up_to_date += not any(f.stage == "store" for f in processed.failures)
             continue
         result = processed.result
+        new.append((path, sha256, result))
         flows += processed.flow is not None
         flow_failed += [f"{processed.run.source}: /camera/side: {f.reason}"
                         for f in processed.failures if f.stage == "soil_flow"]
@@ -111,6 +116,12 @@ def run(args: argparse.Namespace) -> int:
             f"{result.run_id}: {reasons}" if reasons else result.run_id)
     missing = in_transaction(session_factory, lambda session: [
         f"{row.path} (run {row.run.run_id})" for row in mark_missing(session, args.campaign)])
+    if new:
+        def store_pooled(session):
+            for (path, sha256, _), pooled in zip(new, pool_drift([r for *_, r in new])):
+                replace_uncertainty(session, path, sha256, params_hash, pooled.uncertainty)
+
+        in_transaction(session_factory, store_pooled)
     done = sum(len(v) for v in statuses.values())
     print(f"processed {done} of {len(paths)} runs ({up_to_date} already up to date): "
           f"{len(statuses['ok'])} ok, {len(statuses['flagged'])} flagged, "

@@ -12,8 +12,12 @@ from swtlab_cli import exit_codes
 from swtlab.atomic import atomic_file
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
-                   "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
-                   "torque_nm_mean", "sinkage_m_mean", "resistance_n_mean", "image_slip_mean"]
+                   "window_start_s", "window_end_s", "slip_mean", "slip_u95", "dp_n_mean",
+                   "dp_n_se", "dp_n_u95", "torque_nm_mean", "torque_nm_u95", "sinkage_m_mean",
+                   "sinkage_m_u95", "resistance_n_mean", "resistance_n_u95", "image_slip_mean"]
+
+REPLICATE_COLUMNS = ["wheel", "mode", "multipass", "load_set_n", "slip_setpoint", "quantity",
+                     "runs", "mean", "replicate_sd", "within_u", "ratio", "larger"]
 
 TOWED_COLUMNS = ["wheel", "soil", "multipass", "load_n", "towed_resistance_n",
                  "towed_resistance_se_n", "powered_resistance_at_zero_slip_n",
@@ -24,16 +28,21 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
         "results", help="list the results of every run in the database",
         description="One row per run: identifiers and conditions, status and flags, the stable "
-                    "window, and each quantity's mean, standard deviation and standard error in "
-                    "SI units (columns: docs/results.md). Without --csv/--json, a summary table.")
+                    "window, and each quantity's mean, standard deviation, standard error and "
+                    "uncertainty budget (u, u95 = k u, terms) in SI units (columns: "
+                    "docs/results.md). Without --csv/--json, a summary table.")
     parser.add_argument("--db", required=True,
                         help="database URL or SQLite file path (read, never created or upgraded)")
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")
     out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
-    parser.add_argument("--towed", action="store_true",
-                        help="instead: motion resistance of the towed runs against powered runs "
-                             "at zero slip, per wheel, soil, multipass and load")
+    instead = parser.add_mutually_exclusive_group()
+    instead.add_argument("--towed", action="store_true",
+                         help="instead: motion resistance of the towed runs against powered runs "
+                              "at zero slip, per wheel, soil, multipass and load")
+    instead.add_argument("--replicates", action="store_true",
+                         help="instead: the spread of replicate runs (same condition) beside "
+                              "their within-run uncertainty, per condition and quantity")
     parser.set_defaults(func=run)
 
 
@@ -58,6 +67,14 @@ def run(args: argparse.Namespace) -> int:
         if table.empty:
             print(f"swtlab results: {args.db}: no towed runs", file=sys.stderr)
             return exit_codes.BAD_INPUT
+    if args.replicates:
+        from swtlab.domain.replicates import NO_REPLICATES, replicate_spread
+
+        table = replicate_spread(table)
+        if table.empty:
+            print(f"swtlab results: {args.db}: {NO_REPLICATES}")
+            return exit_codes.OK
+        table = table.assign(run_ids=table["run_ids"].map(" ".join))
     if args.csv:
         with atomic_file(args.csv, newline="") as stream:
             table.to_csv(stream, index=False)
@@ -66,6 +83,9 @@ def run(args: argparse.Namespace) -> int:
         print(table.to_json(orient="records", indent=1))
     elif args.towed:
         print(table[TOWED_COLUMNS].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    elif args.replicates:
+        columns = [c for c in REPLICATE_COLUMNS if c in table.columns]
+        print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     else:
         columns = [c for c in SUMMARY_COLUMNS if c in table.columns]
         print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))

@@ -397,3 +397,29 @@ class SoilFlowFailure(Base):
 
     raw_file: Mapped[RawFile] = relationship()
     processing: Mapped[ProcessingRecord] = relationship()
+
+
+class RunUncertainty(Base):
+    """The uncertainty budget of one quantity of a run result
+    (``run_results.uncertainty_budget``): the correction added to the window mean, each
+    term's standard uncertainty (NULL: not in the budget), combined ``u``, effective degrees
+    of freedom (NULL: infinite), coverage factor ``k``, ``u95 = k u`` and what was not measured."""
+
+    __tablename__ = "run_uncertainty"
+    __table_args__ = (UniqueConstraint("run_result_id", "quantity"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    run_result_id: Mapped[int] = mapped_column(ForeignKey("run_result.id"))
+    quantity: Mapped[str] = mapped_column(String(60))
+    unit: Mapped[str] = mapped_column(String(20))
+    correction: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_statistical: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_zero_drift: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_calibration: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_quantisation: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_phase_sampling: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_clock: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u: Mapped[float | None] = mapped_column(Float, nullable=True)
+    dof: Mapped[float | None] = mapped_column(Float, nullable=True)
+    k: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u95: Mapped[float | None] = mapped_column(Float, nullable=True)
+    not_measured: Mapped[list] = mapped_column(JSON)

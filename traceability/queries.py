@@ -6,10 +6,10 @@ import pandas as pd
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from swtlab.domain.results import COLUMNS, check_results, wheel_columns
+from swtlab.domain.results import COLUMNS, budget_columns, check_results, wheel_columns
 
-from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult, Soil,
-                                 StableWindow, TestCondition, Wheel)
+from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult,
+                                 RunUncertainty, Soil, StableWindow, TestCondition, Wheel)
 
 STATS = ("mean", "std", "se")
 
@@ -19,8 +19,8 @@ def latest_results(session: Session) -> pd.DataFrame:
     newest version, or an older one its file was reverted to).
 
     Columns are documented in docs/results.md: identifiers, conditions, status and
-    flags, the stable window, ``<quantity>_mean|_std|_se`` per quantity, and the
-    grouser oscillation.
+    flags, the stable window, ``<quantity>_mean|_std|_se`` per quantity, its uncertainty
+    budget ``<quantity>_u|_u95|_k|_dof|_correction|_u_<term>``, and the grouser oscillation.
     """
     newest_result = (select(RunResult.raw_file_id, func.max(RunResult.id).label("result_id"))
                      .group_by(RunResult.raw_file_id).subquery())
@@ -41,6 +41,11 @@ def latest_results(session: Session) -> pd.DataFrame:
     for q in quantities:
         by_result.setdefault(q.run_result_id, {}).update(
             {f"{q.quantity}_{stat}": getattr(q, stat) for stat in STATS})
+    budgets = session.execute(select(RunUncertainty).where(
+        RunUncertainty.run_result_id.in_(result_ids))).scalars().all() if result_ids else []
+    for b in budgets:
+        by_result.setdefault(b.run_result_id, {}).update(budget_columns(b.quantity, {
+            c.key: getattr(b, c.key) for c in RunUncertainty.__table__.columns}))
     records = []
     for row in rows:
         cond, result, window = row.TestCondition, row.RunResult, row.StableWindow

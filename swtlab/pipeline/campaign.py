@@ -64,6 +64,29 @@ class Campaign:
         return wheels_of(self.results) if len(self.results) else {}
 
     @property
+    def replicates(self) -> pd.DataFrame:
+        """Spread of the replicate runs beside their within-run uncertainty, per condition and
+        quantity (``swtlab.domain.replicates.replicate_spread``); empty without replicates."""
+        from swtlab.domain.replicates import replicate_spread
+
+        return replicate_spread(self.results)
+
+    @property
+    def repeatability(self) -> str:
+        """One line: how many conditions have replicates, or that the campaign has none."""
+        from swtlab.domain.replicates import NO_REPLICATES, REPLICATE_KEY
+
+        spread = self.replicates
+        if spread.empty:
+            return NO_REPLICATES
+        conditions = spread[[c for c in REPLICATE_KEY if c in spread]].drop_duplicates()
+        larger = spread.groupby("quantity", sort=False)["larger"].apply(
+            lambda x: (x == "replicates").mean())
+        return (f"{len(conditions)} condition(s) with replicate runs; the replicate spread "
+                "exceeds the within-run uncertainty in "
+                + ", ".join(f"{q} {100 * v:.0f} %" for q, v in larger.items()) + " of them")
+
+    @property
     def names(self) -> list[str]:
         """The campaign names (``swt.run.campaign``) the results hold."""
         return sorted(set(self.results["campaign"])) if len(self.results) else []
