@@ -81,17 +81,18 @@ def _series(run, rig: RigCompliance | None) -> tuple[dict[str, tuple[np.ndarray,
 def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
     """Passing frequency measured in the forces against ``n omega/2pi``; waveform peaks."""
     n = run.metadata.wheel.grouser_count
-    omega = float(np.nanmean(series["wheel_omega_radps"][0][lo:hi]))
-    out = {"grouser_expected_hz": n * abs(omega) / (2.0 * np.pi) if n > 0 else None,
+    omega = series["wheel_omega_radps"][0][lo:hi]
+    expected = n * abs(float(np.nanmean(omega))) / (2.0 * np.pi) if np.isfinite(omega).any() else 0
+    out = {"grouser_expected_hz": _frequency(expected) if n > 0 else None,
            "grouser_measured_hz": None, "grouser_signal": None}
     candidates = [k for k in ("dp_n", "torque_nm", "wheel_load_n")
                   if np.isfinite(series[k][0][lo:hi]).mean() > 0.5
                   and not (k == "dp_n" and run.metadata.run.mode == "free_sled")]
-    if n > 0 and candidates:
+    if out["grouser_expected_hz"] and candidates:
         signal = candidates[0]
         out["grouser_signal"] = signal
-        out["grouser_measured_hz"] = osc.measure_frequency_hz(
-            t[lo:hi], series[signal][0][lo:hi], out["grouser_expected_hz"])
+        out["grouser_measured_hz"] = _frequency(osc.measure_frequency_hz(
+            t[lo:hi], series[signal][0][lo:hi], out["grouser_expected_hz"]))
     frequency = out["grouser_measured_hz"] or out["grouser_expected_hz"]
     for key, name, unit in (("dp_n", "dp", "n"), ("torque_nm", "torque", "nm")):
         y = series[key][0][lo:hi]
@@ -105,6 +106,12 @@ def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
                      "grid over +-40 % of n*omega/2pi refined by Brent; peaks from the "
                      "phase-averaged waveform")
     return out, frequency
+
+
+def _frequency(hz: float) -> float | None:
+    """A passing frequency that can be used (finite, > 0), else None (a wheel that does not
+    turn has none)."""
+    return float(hz) if np.isfinite(hz) and hz > 0 else None
 
 
 def _flags(run, window, oscillation: dict) -> list[str]:

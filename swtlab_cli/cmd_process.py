@@ -6,6 +6,12 @@ parameters is skipped without being read). Each result is stored with its decima
 traces (``run_results.traces``), which the report draws. A run with side-camera frames
 also gets its soil flow over the stable window (``softflow.flow_run``); frames that cannot
 be analysed are reported and recorded, and the run's other results are kept.
+
+A run that fails at any stage (it cannot be read, its results cannot be computed, the
+database refuses it) is listed with file, stage and reason, recorded (``swtlab results``
+shows it as ``failed``) and the batch goes on. Exit 0 when at least one run was processed
+or already up to date, 3 when none could be, 4 only for a fault outside any run (the
+database cannot be opened, for one).
 """
 
 from __future__ import annotations
@@ -18,7 +24,6 @@ from pathlib import Path
 from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
 from swtlab_cli.progress import progress
-
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -43,7 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import ingest
-    from swtlab.pipeline.database import store_processed
+    from swtlab.pipeline.database import store_one
     from swtlab.pipeline.process import ProcessSettings, find_runs, process_file, rig_compliance
     from traceability import open_database
     from traceability.hashing import content_sha256
@@ -65,18 +70,23 @@ def run(args: argparse.Namespace) -> int:
     flow_failed: list[str] = []
     flows = up_to_date = 0
     for path in progress(paths, desc="process", quiet=args.quiet):
-        sha256, _ = content_sha256(path)
-        with session_factory.begin() as session:
-            if processed_file(session, path, sha256, params_hash):
-                up_to_date += 1
-                known = stored_flow_failure(session, path, sha256, params_hash)
-                if known is not None:
-                    flow_failed.append(f"{path}: {known.channel}: {known.problem}")
-                continue
-            processed = process_file(path, settings)
-            stored = store_processed(session, processed, parameters)
-        failed += [f.reason for f in processed.failures if f.stage != "soil_flow"]
-        if processed.result is None:
+        try:
+            sha256, _ = content_sha256(path)
+        except OSError:
+            sha256 = None  # unreadable: process_file records why
+        if sha256 is not None:
+            with session_factory() as session:
+                if processed_file(session, path, sha256, params_hash):
+                    up_to_date += 1
+                    known = stored_flow_failure(session, path, sha256, params_hash)
+                    if known is not None:
+                        flow_failed.append(f"{path}: {known.channel}: {known.problem}")
+                    continue
+        processed = process_file(path, settings)
+        stored = store_one(session_factory, processed, parameters)
+        failed += [f.reason if f.error_type == "IngestError" else f"{f.file}: {f.stage}: {f.reason}"
+                   for f in processed.failures if f.stage != "soil_flow"]
+        if processed.result is None or any(f.stage == "store" for f in processed.failures):
             continue
         if not stored:
             up_to_date += 1

@@ -12,7 +12,7 @@ from sqlalchemy.orm import Session
 
 from plain_json import jsonable
 from traceability.provenance import swtlab_version
-from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
+from traceability.models import RawFile, RunQuantity, RunResult, StableWindow
 from traceability.store import new_processing_record
 from traceability.store_traces import store_traces
 
@@ -58,16 +58,6 @@ def store_run_result(session: Session, raw_file: RawFile, result: Any,
     session.flush()
     store_traces(session, row, result.traces)
     return row
-
-
-def store_ingest_failure(session: Session, path: Path, sha256: str, error: str,
-                         parameters: dict[str, Any]) -> None:
-    """Record a file that could not be read (once per path, content and message)."""
-    known = session.scalars(select(IngestFailure).filter_by(
-        path=str(path.resolve()), sha256=sha256, error=error)).first()
-    if known is None:
-        session.add(IngestFailure(path=str(path.resolve()), sha256=sha256, error=error,
-                                  processing=new_processing_record(session, "ingest", parameters)))
 
 
 def _num(value: Any) -> float | None:
