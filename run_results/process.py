@@ -5,9 +5,11 @@ slip, travel velocity, wheel angular velocity, wheel load ``fz``, drawbar pull, 
 torque ``ty``, thrust ``H = T/r``, motion resistance ``R = T/r - DP`` (Wong, Theory of
 Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correction; for
 steered runs also the side force ``fy`` and the slip angle (logged channel, else the
-set steering angle). Single-channel quantities come from the native samples, the means of
-resistance and sinkage from the channels' native means (``native``). Given the run's track
-photos as measured (``image_slip``: the slip read from the grouser marks by
+set steering angle). Plausibility and sensor health (``plausibility``: saturation, dead
+channels, SE of 0, negative load or sinkage, set against measured load, metadata ranges,
+dig-in) are checked on the calibrated, zeroed channels and flag the run. Single-channel
+quantities come from the native samples, the means of resistance and sinkage from the
+channels' native means (``native``). Given the run's track photos as measured (``image_slip``: the slip read from the grouser marks by
 ``softflow.track_run``, which the pipeline calls; this module opens no photo), the result
 also reports ``image_slip`` beside the encoder slip. Every result carries its channels'
 decimated traces of DP, torque, sinkage and slip (``run_results.traces``), so plots need not
@@ -24,6 +26,7 @@ from run_results import oscillation as osc
 from run_results.corrections import RigCompliance, corrected_heights, tare_record
 from run_results.native import native_quantities
 from run_results.phase_average import phase_average
+from run_results.plausibility import plausibility_flags
 from run_results.result import RunResult
 from run_results.stats import QuantityStats, quantity_stats
 from run_results.traces import run_traces
@@ -183,6 +186,7 @@ def process_run(run, params: StablePhaseParams | None = None,
                        if k in quantities})
     corrections["hub_height_correction_mean_m"] = float(np.nanmean(applied["correction_m"][lo:hi]))
     quantities.update(image_quantities)
-    flags = (*_flags(run, window, oscillation), *image_flags)
+    flags = (*_flags(run, window, oscillation), *image_flags,
+             *plausibility_flags(run, window, quantities, params or StablePhaseParams()))
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,
                      oscillation=oscillation, dp_trace=None, corrections=corrections, **common)
