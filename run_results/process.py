@@ -9,11 +9,11 @@ set steering angle). Plausibility and sensor health (``plausibility``: saturatio
 channels, SE of 0, negative load or sinkage, set against measured load, metadata ranges,
 dig-in) are checked on the calibrated, zeroed channels and flag the run. Single-channel
 quantities come from the native samples, the means of resistance and sinkage from the
-channels' native means (``native``). Given the run's track photos as measured (``image_slip``: the slip read from the grouser marks by
-``softflow.track_run``, which the pipeline calls; this module opens no photo), the result
-also reports ``image_slip`` beside the encoder slip. Every result carries its channels'
-decimated traces of DP, torque, sinkage and slip (``run_results.traces``), so plots need not
-read the raw file again.
+channels' native means (``native``). Given the run's track photos as measured
+(``image_slip``: the slip read from the grouser marks by ``softflow.track_run``, which the
+pipeline calls; this module opens no photo), the result also reports ``image_slip`` beside
+the encoder slip. Every result carries its channels' decimated traces of DP, torque,
+sinkage and slip (``run_results.traces``), so plots need not read the raw file again.
 """
 
 from __future__ import annotations
