@@ -14,8 +14,8 @@ window statistics: each check that fails is a flag with its reason (the run's st
   stiffness, grouser count and height, set load, gravity);
 - dig-in: the drawbar pull rose to a peak after the speeds reached their set points and
   collapsed before the window (slip sinkage at high slip: Ding et al. 2011, J.
-  Terramechanics 48(1)), or sinkage grows through the window, even when the window itself
-  looks flat.
+  Terramechanics 48(1)), or sinkage grew through the first candidate window of which only
+  the flat second half was kept: a tail that looks flat after a dig-in.
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ from __future__ import annotations
 import numpy as np
 
 from ingest.canonical import WRENCH_COLUMNS
-from stable_phase.checks import slope_test
 from stable_phase.signals import grouser_period_s, moving_average
 from swtlab.domain.ranges import METADATA, WHEEL_KEYS
 
@@ -153,8 +152,8 @@ def metadata_flags(metadata) -> list[str]:
 def dig_in_flags(run, window, params) -> list[str]:
     """Drawbar pull that rose and collapsed between the gate and the window (by more than
     :data:`DIG_IN_COLLAPSE_RATIO` of its peak and ``params.dig_in_dp_drop_ratio`` of the set
-    load), or sinkage that grows significantly
-    through the window (by more than ``params.slope_change_sinkage_ratio`` of its mean)."""
+    load), or sinkage that grew significantly through the first candidate window when only
+    its flat second half was kept (stable-phase slope test)."""
     ch, load = run.channels, run.metadata.run.load_n
     t = ch["t_s"].to_numpy()
     gate_s = window.diagnostics.get("gate_start_s")
@@ -177,14 +176,11 @@ def dig_in_flags(run, window, params) -> list[str]:
                 at = t[lo + int(np.nanargmax(before))]
                 flags.append(f"dig-in: drawbar pull rose to {peak:.4g} N at {at:.1f} s, then "
                              f"collapsed to {level:.4g} N in the window")
-    z = ch["sinkage_m"].to_numpy()[start:stop]
-    if np.isfinite(z).mean() > 0.5:
-        test = slope_test(t[start:stop], z)
-        mean = abs(float(np.nanmean(z)))
-        if test["p"] < params.slope_alpha and test["change"] > \
-                params.slope_change_sinkage_ratio * mean:
-            flags.append(f"dig-in: sinkage grows by {1e3 * test['change']:.3g} mm through the "
-                         "window")
+    first = window.diagnostics.get("checks_window", {}).get("sinkage_m", {})
+    if window.diagnostics.get("shrunk_to_second_half") and first.get("drifts") \
+            and first["change"] > 0:
+        flags.append(f"dig-in: sinkage grew by {1e3 * first['change']:.3g} mm through the first "
+                     "candidate window (the window kept is its flat second half)")
     return flags
 
 
