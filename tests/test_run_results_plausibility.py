@@ -151,3 +151,22 @@ def test_a_dig_in_with_a_flat_tail_is_flagged(tmp_path):
     peak = float(flag.split("rose to ")[1].split(" N")[0])
     assert peak == pytest.approx(expected, abs=3.0)
     assert plain.flags == () and result.status == "flagged"
+
+
+def test_sinkage_growing_through_the_first_window_is_a_dig_in(tmp_path):
+    """The hub sinks 4 mm more, at a steady 0.2 mm/s from 20 to 40 s, then holds: the window
+    kept is the flat second half, and the growth through the first candidate window (at most
+    the 4 mm of the ramp) is flagged."""
+    arm_m = 0.6
+
+    def sink(t, angle):
+        drop_m = np.clip((t - 20.0) / 20.0, 0.0, 1.0) * 0.004
+        return np.arcsin(np.sin(angle) - drop_m / arm_m)  # h = L (sin a - sin a0), spec
+
+    run, result = _process(tmp_path, lambda c: _map_field(c, "/suspension/angle", ("angle",),
+                                                          sink))
+    assert run.metadata.suspension.arm_length_m == arm_m
+    assert result.window.diagnostics["shrunk_to_second_half"]
+    (flag,) = _flags(result, "dig-in: sinkage grew by")
+    grown_mm = float(flag.split("grew by ")[1].split(" mm")[0])
+    assert 0.5 < grown_mm <= 4.0 and result.status == "flagged"
