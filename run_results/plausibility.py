@@ -7,7 +7,8 @@ window statistics: each check that fails is a flag with its reason (the run's st
 - dead or constant channels: a measured channel whose native samples never change over the
   whole run (a wheel that never turns, a disconnected load cell);
 - a standard error of 0, or a statistic that is not finite;
-- negative wheel load, or negative sinkage, beyond the noise;
+- negative wheel load, or negative sinkage, beyond the noise; slip outside [-1, 1], a
+  drawbar pull beyond any soil's traction, sinkage deeper than the wheel radius;
 - the measured wheel load against the set load beyond :data:`LOAD_REL_TOL`;
 - a speed that missed its set point (the gate held the run to its own plateau instead);
 - metadata outside the plausible ranges of ``swtlab.domain.ranges`` (wheel radius, width,
@@ -41,6 +42,9 @@ LOAD_REL_TOL = 0.25
 #: a negative load or sinkage beyond max(NOISE_SIGMAS * SE, floor) is flagged
 NOISE_SIGMAS = 3.0
 NEGATIVE_SINKAGE_FLOOR_M = 1e-3
+#: |DP| / W above this is beyond any soil's traction: DP < H_max = A c + W tan(phi)
+#: (Coulomb-Micklethwaite; Wong, Theory of Ground Vehicles), and tan(phi) < 1 for soils
+MAX_TRACTION_RATIO = 1.5
 #: a drawbar pull that falls by this share of its (driving) peak has collapsed; a settling
 #: transient's overshoot falls by about a tenth (virtual testbed, sample campaign)
 DIG_IN_COLLAPSE_RATIO = 0.3
@@ -122,6 +126,31 @@ def load_flags(run, quantities: dict) -> list[str]:
     return flags
 
 
+def physical_flags(run, quantities: dict) -> list[str]:
+    """Means no wheel on soil gives: slip outside [-1, 1] (an encoder glitch, or a wheel
+    turning against its travel), |DP| above :data:`MAX_TRACTION_RATIO` times the measured
+    load, sinkage deeper than the wheel radius."""
+    flags = []
+
+    def mean(name):
+        q = quantities.get(name)
+        return q.mean if q is not None and np.isfinite(q.mean) else None
+
+    for name in ("slip", "image_slip"):
+        if mean(name) is not None and abs(mean(name)) > 1.0:
+            flags.append(f"{name} {mean(name):.4g} outside [-1, 1]: encoder glitch or the "
+                         "wheel turning against its travel")
+    load, dp = mean("wheel_load_n"), mean("dp_n")
+    if load and dp is not None and abs(dp) > MAX_TRACTION_RATIO * abs(load):
+        flags.append(f"drawbar pull {dp:.4g} N over {MAX_TRACTION_RATIO:g} times the wheel "
+                     f"load {load:.4g} N")
+    radius, sinkage = run.metadata.wheel.radius_m, mean("sinkage_m")
+    if sinkage is not None and sinkage > radius:
+        flags.append(f"sinkage {1e3 * sinkage:.4g} mm deeper than the wheel radius "
+                     f"{1e3 * radius:g} mm")
+    return flags
+
+
 def set_point_flags(window) -> list[str]:
     """Speeds the gate found away from their set point (held to their own plateau)."""
     flags = []
@@ -190,4 +219,5 @@ def plausibility_flags(run, window, quantities: dict, params) -> list[str]:
     return [*metadata_flags(run.metadata), *dead_channel_flags(run),
             *saturation_flags(run, window.start_s, window.end_s),
             *statistics_flags(quantities), *load_flags(run, quantities),
+            *physical_flags(run, quantities),
             *set_point_flags(window), *dig_in_flags(run, window, params)]
