@@ -47,13 +47,18 @@ def store_processed(session, done: ProcessedRun, parameters: dict) -> bool:
 def store_one(session_factory, done: ProcessedRun, parameters: dict) -> bool:
     """:func:`store_processed` in a transaction of its own. A run the database refuses (a
     value it cannot hold, a constraint) is rolled back and recorded as a failure of stage
-    ``store`` in ``done.failures`` and in the database; the batch goes on. Returns whether a
-    new result was stored."""
+    ``store`` in ``done.failures`` and in the database; the batch goes on. A database that
+    is locked or unreachable raises (no run's fault). Returns whether a new result was
+    stored."""
+    from sqlalchemy.exc import InterfaceError, OperationalError
+
     from traceability.store_failures import store_failure
 
     try:
         with session_factory.begin() as session:
             return store_processed(session, done, parameters)
+    except (OperationalError, InterfaceError):
+        raise  # the database itself (locked, gone): not this run's fault
     except Exception as error:  # noqa: BLE001 - one run the database refuses, not the batch
         failure = Failure.of(done.path, "store", getattr(error, "orig", None) or error)
         done.failures.append(failure)
