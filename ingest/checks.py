@@ -46,10 +46,21 @@ def check_topic(path: Path, topic: str, raw: RawTopic) -> None:
 MAX_CELL_CHARS = 40
 
 
+def _float_or_nan(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return float("nan")
+
+
 def numeric_column(path: Path, frame: pd.DataFrame, column: str, first_row: int) -> np.ndarray:
     """A text-table column as float64; a non-numeric cell is an IngestError naming the first
     one (``first_row``: the file's line number of the frame's first data row)."""
-    values = pd.to_numeric(frame[column], errors="coerce").to_numpy(np.float64)
+    try:
+        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(np.float64)
+    except OverflowError:  # an integer cell beyond float64: inf, which check_topic reports
+        values = pd.to_numeric(frame[column].astype(str).map(_float_or_nan),
+                               errors="coerce").to_numpy(np.float64)
     bad = np.isnan(values) & frame[column].notna().to_numpy()
     if bad.any():
         row = int(np.argmax(bad))

@@ -8,7 +8,7 @@ window statistics: each check that fails is a flag with its reason (the run's st
   whole run (a wheel that never turns, a disconnected load cell);
 - a standard error of 0, or a statistic that is not finite;
 - negative wheel load, or negative sinkage, beyond the noise; slip outside [-1, 1], a
-  drawbar pull beyond any soil's traction, sinkage deeper than the wheel radius;
+  drawbar pull or thrust beyond any soil's traction, sinkage deeper than the wheel radius;
 - the measured wheel load against the set load beyond :data:`LOAD_REL_TOL`;
 - a speed that missed its set point (the gate held the run to its own plateau instead);
 - metadata outside the plausible ranges of ``swtlab.domain.ranges`` (wheel radius, width,
@@ -42,8 +42,8 @@ LOAD_REL_TOL = 0.25
 #: a negative load or sinkage beyond max(NOISE_SIGMAS * SE, floor) is flagged
 NOISE_SIGMAS = 3.0
 NEGATIVE_SINKAGE_FLOOR_M = 1e-3
-#: |DP| / W above this is beyond any soil's traction: DP < H_max = A c + W tan(phi)
-#: (Coulomb-Micklethwaite; Wong, Theory of Ground Vehicles), and tan(phi) < 1 for soils
+#: |DP| / W or |T/r| / W above this is beyond any soil's traction: DP < H <= H_max =
+#: A c + W tan(phi) (Coulomb-Micklethwaite; Wong, Theory of Ground Vehicles), tan(phi) < 1
 MAX_TRACTION_RATIO = 1.5
 #: a drawbar pull that falls by this share of its (driving) peak has collapsed; a settling
 #: transient's overshoot falls by about a tenth (virtual testbed, sample campaign)
@@ -128,8 +128,8 @@ def load_flags(run, quantities: dict) -> list[str]:
 
 def physical_flags(run, quantities: dict) -> list[str]:
     """Means no wheel on soil gives: slip outside [-1, 1] (an encoder glitch, or a wheel
-    turning against its travel), |DP| above :data:`MAX_TRACTION_RATIO` times the measured
-    load, sinkage deeper than the wheel radius."""
+    turning against its travel), |DP| or |T/r| above :data:`MAX_TRACTION_RATIO` times the
+    measured load, sinkage deeper than the wheel radius."""
     flags = []
 
     def mean(name):
@@ -140,10 +140,12 @@ def physical_flags(run, quantities: dict) -> list[str]:
         if mean(name) is not None and abs(mean(name)) > 1.0:
             flags.append(f"{name} {mean(name):.4g} outside [-1, 1]: encoder glitch or the "
                          "wheel turning against its travel")
-    load, dp = mean("wheel_load_n"), mean("dp_n")
-    if load and dp is not None and abs(dp) > MAX_TRACTION_RATIO * abs(load):
-        flags.append(f"drawbar pull {dp:.4g} N over {MAX_TRACTION_RATIO:g} times the wheel "
-                     f"load {load:.4g} N")
+    load = mean("wheel_load_n")
+    for name, label in (("dp_n", "drawbar pull"), ("thrust_n", "thrust T/r")):
+        value = mean(name)
+        if load and value is not None and abs(value) > MAX_TRACTION_RATIO * abs(load):
+            flags.append(f"{label} {value:.4g} N over {MAX_TRACTION_RATIO:g} times the wheel "
+                         f"load {load:.4g} N")
     radius, sinkage = run.metadata.wheel.radius_m, mean("sinkage_m")
     if sinkage is not None and sinkage > radius:
         flags.append(f"sinkage {1e3 * sinkage:.4g} mm deeper than the wheel radius "

@@ -147,3 +147,16 @@ def test_a_cmu_file_cut_to_a_few_lines_fails_cleanly(tmp_path, ingest_cmu_root, 
     done = process_file(cut, ProcessSettings(channel_map=CMU_MAP, max_frames=0))
     assert [f.error_type for f in done.failures] in ([], ["IngestError"])
     assert done.result is None or done.result.status == "no_stable_phase"
+
+
+def test_a_cmu_cell_beyond_float64_is_refused(tmp_path, ingest_cmu_root):
+    """pandas raises OverflowError on a 400-digit integer cell instead of coercing it."""
+    source = _cmu_file(ingest_cmu_root)
+    lines = source.read_text().splitlines(keepends=True)[:200]
+    cells = lines[50].split(",")
+    cells[0] = "1" + "0" * 400
+    lines[50] = ",".join(cells)
+    bad = tmp_path / source.name
+    bad.write_text("".join(lines))
+    err = _error(bad, CMU_MAP)
+    assert err.channel == "/cmu/motion.x" and "NaN/inf" in err.problem

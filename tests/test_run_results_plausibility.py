@@ -170,3 +170,16 @@ def test_sinkage_growing_through_the_first_window_is_a_dig_in(tmp_path):
     (flag,) = _flags(result, "dig-in: sinkage grew by")
     grown_mm = float(flag.split("grew by ")[1].split(" mm")[0])
     assert 0.5 < grown_mm <= 4.0 and result.status == "flagged"
+
+
+def test_a_torque_zero_far_off_gives_a_thrust_no_soil_can_and_is_flagged(tmp_path):
+    """swt.zero.ty = 500 N*m instead of its own zero z0: the torque drops by 500 - z0, the
+    thrust T/r by (500 - z0)/0.125, about -3900 N against a 180 N load (found by the fuzzer,
+    stored as ok before)."""
+    plain_run, plain = _process(tmp_path)
+    run, result = _process(tmp_path, metadata={("zero", "ty"): "500"})
+    shift_nm = 500.0 - plain_run.metadata.zero["ty"]
+    expected = (plain.quantities["torque_nm"].mean - shift_nm) / run.metadata.wheel.radius_m
+    assert result.quantities["thrust_n"].mean == pytest.approx(expected, rel=1e-3)
+    (flag,) = _flags(result, "thrust T/r")
+    assert "over 1.5 times the wheel load" in flag and result.status == "flagged"
