@@ -3,7 +3,8 @@
 The corpus: runs written by the virtual testbed (the committed sample campaign: MCAP files
 and CSV run folders; in-family, same writer as the spec) and real CMU motion logs read
 through their channel map (independent). Each case changes one of: MCAP bytes, one JSON
-block, one metadata value, one CSV cell or line, one ``run.json`` value, one channel-map key,
+block, one whole channel (scaled, negated, offset, flat, clipped, spiked, frozen), one
+metadata value, one CSV cell or line, one ``run.json`` value, one channel-map key,
 or cuts a CMU file short, to a value from a list of known-hostile ones (huge, tiny,
 non-finite, wrong-typed, nested, math text, paths outside the run) or a random one.
 ``case(seed, i)`` is the same input on every machine.
@@ -155,6 +156,41 @@ def _json_block(rng, run_id: str) -> Case:
     return Case("json_block", f"{run_id} {message.topic}: {how} {name} = {value[:24]}", write)
 
 
+def _channel(rng, run_id: str) -> Case:
+    """A whole channel made wrong but finite: scaled, negated, offset, flat, clipped,
+    spiked or frozen part way (a unit slip, a sign error, a dead or saturating sensor)."""
+    content = _fresh(run_id)
+    topic = _pick(rng, sorted({content.messages[i].topic for i in _sensor_messages(content)}))
+    blocks = content.blocks(topic)
+    name = _pick(rng, [k for k in blocks[0] if k != "t_ns"])
+    y = np.concatenate([np.asarray(b[name], float) for b in blocks])
+    how = _pick(rng, ("scale", "negate", "offset", "flat", "clip", "spikes", "freeze"))
+    if how == "scale":
+        y = y * float(_pick(rng, (10.0, 0.1, 1000.0, 1e-3, 4.448, 0.0254)))
+    elif how == "negate":
+        y = -y
+    elif how == "offset":
+        y = y + float(_pick(rng, (-1.0, 1.0, -100.0, 100.0, -1e4)))
+    elif how == "flat":
+        y = np.full_like(y, float(_pick(rng, (0.0, float(np.median(y)), -1.0))))
+    elif how == "clip":
+        y = np.clip(y, None, np.percentile(y, float(rng.uniform(5, 95))))
+    elif how == "spikes":
+        at = rng.integers(len(y), size=int(rng.integers(1, 20)))
+        y[at] = y[at] + float(_pick(rng, (1e3, -1e3, 1e5)))
+    else:
+        y[int(rng.integers(len(y))):] = y[0]
+    start = 0
+    for b in blocks:
+        b[name] = y[start:start + len(b[name])].tolist()
+        start += len(b[name])
+    content.set_blocks(topic, blocks)
+
+    def write(folder: Path):
+        return write_content(folder / f"{run_id}.mcap", content), None
+    return Case("channel", f"{run_id} {topic}.{name}: {how}", write)
+
+
 def _metadata(rng, run_id: str) -> Case:
     content = _fresh(run_id)
     record = _pick(rng, sorted(content.metadata))
@@ -287,8 +323,8 @@ def _cmu_file(rng) -> Case:
 
 
 #: case kinds and their weights
-KINDS = (("mcap_bytes", 2), ("json_block", 4), ("metadata", 4), ("csv_cell", 2),
-         ("run_json", 2), ("channel_map", 2), ("cmu_file", 1))
+KINDS = (("mcap_bytes", 2), ("json_block", 4), ("channel", 2), ("metadata", 4),
+         ("csv_cell", 2), ("run_json", 2), ("channel_map", 2), ("cmu_file", 1))
 
 
 def case(seed: int, index: int) -> Case:
@@ -301,6 +337,8 @@ def case(seed: int, index: int) -> Case:
         return _mcap_bytes(rng, _pick(rng, MCAP_RUNS))
     if kind == "json_block":
         return _json_block(rng, _pick(rng, MCAP_RUNS))
+    if kind == "channel":
+        return _channel(rng, _pick(rng, MCAP_RUNS))
     if kind == "metadata":
         return _metadata(rng, _pick(rng, MCAP_RUNS))
     if kind == "csv_cell":

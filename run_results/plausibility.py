@@ -4,6 +4,7 @@ window statistics: each check that fails is a flag with its reason (the run's st
 
 - saturation: a force or torque channel flat-topped at a rail (samples pile up at the
   extreme value instead of thinning out towards it, as a noisy signal's tail does);
+- spikes: a force or torque sample more than twice the set load from the window's median;
 - dead or constant channels: a measured channel whose native samples never change over the
   whole run (a wheel that never turns, a disconnected load cell);
 - a standard error of 0, or a statistic that is not finite;
@@ -37,6 +38,8 @@ MEASURED_CHANNELS = (*RAIL_CHANNELS, "wheel_angle_rad", "sled_position_m",
 RAIL_MIN_SAMPLES, RAIL_MIN_FRACTION = 5, 0.02
 #: ... and this many times the samples of the next level below it
 RAIL_PILE_RATIO = 2.0
+#: a force sample this many set loads from the window's median is a glitch
+SPIKE_LOAD_RATIO = 2.0
 #: measured load this far (share of the set load) from the set load is flagged
 LOAD_REL_TOL = 0.25
 #: a negative load or sinkage beyond max(NOISE_SIGMAS * SE, floor) is flagged
@@ -77,6 +80,26 @@ def saturation_flags(run, start_s: float, end_s: float) -> list[str]:
                     and at_rail > RAIL_PILE_RATIO * next_level):
                 flags.append(f"{column} saturated: {100 * at_rail / y.size:.1f} % of the window's "
                              f"samples sit at its {name} {rail:.6g} (flat-topped at a rail)")
+    return flags
+
+
+def spike_flags(run, start_s: float, end_s: float) -> list[str]:
+    """Force/torque samples that jump from the window's median by more than
+    :data:`SPIKE_LOAD_RATIO` times the set load (times the radius for a torque): an electrical
+    glitch, not the soil (a stone under the wheel loads it by a fraction of its load)."""
+    load, radius = run.metadata.run.load_n, run.metadata.wheel.radius_m
+    flags = []
+    for column in RAIL_CHANNELS:
+        found = _native(run, column)
+        if found is None:
+            continue
+        _, t, y = found
+        y = y[(t >= start_s) & (t <= end_s)]
+        scale = SPIKE_LOAD_RATIO * load * (radius if column.endswith("_nm") else 1.0)
+        jumps = int(np.sum(np.abs(y - np.median(y)) > scale)) if y.size else 0
+        if jumps:
+            flags.append(f"{column}: {jumps} samples jump more than {scale:.4g} from the window's "
+                         f"median ({SPIKE_LOAD_RATIO:g} x the set load): electrical spikes?")
     return flags
 
 
@@ -220,6 +243,7 @@ def plausibility_flags(run, window, quantities: dict, params) -> list[str]:
     ``StablePhaseParams`` the window was found with)."""
     return [*metadata_flags(run.metadata), *dead_channel_flags(run),
             *saturation_flags(run, window.start_s, window.end_s),
+            *spike_flags(run, window.start_s, window.end_s),
             *statistics_flags(quantities), *load_flags(run, quantities),
             *physical_flags(run, quantities),
             *set_point_flags(window), *dig_in_flags(run, window, params)]

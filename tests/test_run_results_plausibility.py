@@ -183,3 +183,16 @@ def test_a_torque_zero_far_off_gives_a_thrust_no_soil_can_and_is_flagged(tmp_pat
     assert result.quantities["thrust_n"].mean == pytest.approx(expected, rel=1e-3)
     (flag,) = _flags(result, "thrust T/r")
     assert "over 1.5 times the wheel load" in flag and result.status == "flagged"
+
+
+def test_electrical_spikes_are_flagged(tmp_path):
+    """Three fz samples at 35, 40 and 45 s read 1000 N more (found by the fuzzer: the spikes
+    inflate the SE until a negative sinkage looked like noise, stored as ok)."""
+    def spikes(t, y):
+        y = y.copy()
+        y[[int(np.argmin(np.abs(t - s))) for s in (35.0, 40.0, 45.0)]] += 1000.0
+        return y
+
+    _, result = _process(tmp_path, lambda c: _map_field(c, "/hub/wrench", ("fz",), spikes))
+    (flag,) = _flags(result, "fz_n: 3 samples jump more than 360")
+    assert "2 x the set load" in flag and result.status == "flagged"
