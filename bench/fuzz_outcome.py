@@ -3,7 +3,8 @@ limit, and say what came of it: a clean refusal, a result, or one of the three f
 reliability bench counts (unhandled exception, hang, nonsense stored as ok).
 
 "Nonsense" is judged here from physics alone, not from the flags of the code under test: a
-run marked ``ok`` whose statistics are not finite or have an SE of 0, or whose values no
+run marked ``ok`` whose statistics are not finite, whose load-cell quantities have an SE of
+0, or whose values no
 single-wheel test can give (|slip| > 1, wheel load <= 0 or over 10 times the set load,
 |DP| or |thrust| over 3 times the measured load, |torque| over 3 load-radii, sinkage below
 -1 mm or over the wheel diameter, speeds over 10 m/s or 1000 rad/s).
@@ -23,6 +24,9 @@ from swtlab.pipeline.process import ProcessSettings, process_file
 #: error types that are the pipeline's own clean refusals (one line naming file and channel)
 CLEAN_ERRORS = ("IngestError",)
 TIME_LIMIT_S = 20.0
+#: quantities measured by load cells: their noise never gives a window an SE of 0 (an
+#: encoder's may hold one quantisation step)
+LOAD_CELL = ("wheel_load_n", "dp_n", "torque_nm", "thrust_n", "resistance_n", "side_force_n")
 
 
 class Hang(BaseException):
@@ -50,7 +54,7 @@ def nonsense(result) -> str | None:
         values = (stats.mean, stats.std, stats.se)
         if not all(v is not None and math.isfinite(v) for v in values):
             return f"{name}: non-finite statistic {values}"
-        if stats.se == 0 and name != "slip_angle_deg":
+        if stats.se == 0 and name in LOAD_CELL:
             return f"{name}: SE of 0"
     c = result.condition
     radius, load_set = c["wheel_radius_m"], c["load_n"]

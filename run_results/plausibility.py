@@ -7,7 +7,7 @@ window statistics: each check that fails is a flag with its reason (the run's st
 - spikes: a force or torque sample more than twice the set load from the window's median;
 - dead or constant channels: a measured channel whose native samples never change over the
   whole run (a wheel that never turns, a disconnected load cell);
-- a standard error of 0, or a statistic that is not finite;
+- a standard error of 0 of a load-cell quantity, or a statistic that is not finite;
 - negative wheel load, or negative sinkage, beyond the noise; slip outside [-1, 1], a
   drawbar pull or thrust beyond any soil's traction, sinkage deeper than the wheel radius;
 - the measured wheel load against the set load beyond :data:`LOAD_REL_TOL`;
@@ -51,8 +51,10 @@ MAX_TRACTION_RATIO = 1.5
 #: a drawbar pull that falls by this share of its (driving) peak has collapsed; a settling
 #: transient's overshoot falls by about a tenth (virtual testbed, sample campaign)
 DIG_IN_COLLAPSE_RATIO = 0.3
-#: quantities set, not measured, whose SE is 0 by construction
-SET_QUANTITIES = ("slip_angle_deg",)
+#: quantities from load cells, whose noise never lets a window be constant; an encoder's
+#: (hub height, slip) may hold one quantisation step over a window (SE 0 from resolution)
+LOAD_CELL_QUANTITIES = ("wheel_load_n", "dp_n", "torque_nm", "thrust_n", "resistance_n",
+                        "side_force_n")
 
 
 def _native(run, column: str):
@@ -115,13 +117,13 @@ def dead_channel_flags(run) -> list[str]:
 
 
 def statistics_flags(quantities: dict) -> list[str]:
-    """Statistics that are not finite, and standard errors of 0."""
+    """Statistics that are not finite, and standard errors of 0 of load-cell quantities."""
     flags = []
     for name, q in quantities.items():
         values = (q.mean, q.std, q.se)
         if not all(v is not None and np.isfinite(v) for v in values):
             flags.append(f"{name}: mean, std or SE is not finite")
-        elif q.se == 0 and name not in SET_QUANTITIES:
+        elif q.se == 0 and name in LOAD_CELL_QUANTITIES:
             flags.append(f"{name}: SE of 0 (the channel does not vary over the window)")
     return flags
 
