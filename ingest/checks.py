@@ -10,7 +10,7 @@ import pandas as pd
 from ingest.errors import IngestError
 from ingest.raw import RawTopic
 from ingest.units import column_quantity
-from swtlab.domain.ranges import CHANNEL_LIMITS
+from swtlab.domain.ranges import CHANNEL_LIMITS, COLUMN_LIMITS
 
 
 def check_topic(path: Path, topic: str, raw: RawTopic) -> None:
@@ -73,14 +73,14 @@ def numeric_column(path: Path, frame: pd.DataFrame, column: str, first_row: int)
 
 def check_calibrated(path: Path, where: str, column: str, values: np.ndarray) -> None:
     """A channel after calibration and zeroing: every sample finite and within the
-    magnitude its quantity can have on a testbed (``swtlab.domain.ranges.CHANNEL_LIMITS``);
+    magnitude its quantity (or column) can have on a testbed (``swtlab.domain.ranges``);
     beyond it the gain, offset, zero or unit is wrong."""
     bad = ~np.isfinite(values)
     if bad.any():
         raise IngestError(path, where, f"{int(bad.sum())} samples of {column} are NaN/inf after "
                           "calibration and zeroing (gain, offset or zero overflows)")
     quantity = column_quantity(column)
-    limit = CHANNEL_LIMITS[quantity]
+    limit = COLUMN_LIMITS.get(column, CHANNEL_LIMITS[quantity])
     peak = float(np.max(np.abs(values))) if values.size else 0.0
     if peak > limit:
         raise IngestError(path, where, f"{column} reaches {peak:.3g} (SI) after calibration "

@@ -46,7 +46,7 @@ def _samples(run, column: str, start_s: float, end_s: float):
     return None
 
 
-def _hub_samples(run, start_s: float, end_s: float):
+def hub_samples(run, start_s: float, end_s: float):
     """A logged hub height, or the arm angle through ``L (sin(angle) - sin(angle_zero))``."""
     direct = _samples(run, "hub_height_m", start_s, end_s)
     angle = _samples(run, "suspension_angle_rad", start_s, end_s)
@@ -83,7 +83,7 @@ def native_quantities(run, start_s: float, end_s: float, units: dict[str, str],
             result = native_stats(t, y / radius if per_radius else y, frequency_hz, units[key])
             if result is not None:
                 stats[key] = result
-    hub = _hub_samples(run, start_s, end_s)
+    hub = hub_samples(run, start_s, end_s)
     if hub is not None and (rig is None or rig.kind == "linear"):
         result = native_stats(*hub, frequency_hz, units["hub_height_m"])
         if result is not None:

@@ -4,7 +4,8 @@ window statistics: each check that fails is a flag with its reason (the run's st
 
 - saturation: a force or torque channel flat-topped at a rail (samples pile up at the
   extreme value instead of thinning out towards it, as a noisy signal's tail does);
-- spikes: a force or torque sample more than twice the set load from the window's median;
+- spikes: a force or torque sample more than twice the set load from the window's median,
+  a hub height more than the wheel radius from it;
 - dead or constant channels: a measured channel whose native samples never change over the
   whole run (a wheel that never turns, a disconnected load cell);
 - a standard error of 0 of a load-cell quantity, or a statistic that is not finite;
@@ -25,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ingest.canonical import WRENCH_COLUMNS
+from run_results.native import hub_samples
 from stable_phase.signals import grouser_period_s, moving_average
 from swtlab.domain.ranges import METADATA, WHEEL_KEYS
 
@@ -88,7 +90,8 @@ def saturation_flags(run, start_s: float, end_s: float) -> list[str]:
 def spike_flags(run, start_s: float, end_s: float) -> list[str]:
     """Force/torque samples that jump from the window's median by more than
     :data:`SPIKE_LOAD_RATIO` times the set load (times the radius for a torque): an electrical
-    glitch, not the soil (a stone under the wheel loads it by a fraction of its load)."""
+    glitch, not the soil (a stone under the wheel loads it by a fraction of its load); and hub
+    heights (from the arm angle) that jump by more than the wheel radius."""
     load, radius = run.metadata.run.load_n, run.metadata.wheel.radius_m
     flags = []
     for column in RAIL_CHANNELS:
@@ -102,6 +105,12 @@ def spike_flags(run, start_s: float, end_s: float) -> list[str]:
         if jumps:
             flags.append(f"{column}: {jumps} samples jump more than {scale:.4g} from the window's "
                          f"median ({SPIKE_LOAD_RATIO:g} x the set load): electrical spikes?")
+    hub = hub_samples(run, start_s, end_s)
+    if hub is not None and hub[1].size:
+        jumps = int(np.sum(np.abs(hub[1] - np.median(hub[1])) > radius))
+        if jumps:
+            flags.append(f"hub_height_m: {jumps} samples jump more than the wheel radius "
+                         f"{radius:g} m from the window's median: arm encoder spikes?")
     return flags
 
 

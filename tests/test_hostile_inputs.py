@@ -160,3 +160,10 @@ def test_a_cmu_cell_beyond_float64_is_refused(tmp_path, ingest_cmu_root):
     bad.write_text("".join(lines))
     err = _error(bad, CMU_MAP)
     assert err.channel == "/cmu/motion.x" and "NaN/inf" in err.problem
+
+
+def test_an_arm_angle_beyond_a_turn_is_refused(tmp_path):
+    block = _first_block("/suspension/angle")
+    block["angle"][0] = 1000.0
+    err = _error(_with_block(tmp_path, "/suspension/angle", json.dumps(block).encode()))
+    assert err.channel == "/suspension/angle.angle" and "after calibration" in err.problem

@@ -73,3 +73,8 @@ CHANNEL_LIMITS: dict[str, float] = {
     "force": 1e6, "torque": 1e5, "angle": 1e8, "length": 1e4, "velocity": 1e3,
     "angular_velocity": 1e5, "time": 1e6, "dimensionless": 1e6,
 }
+
+#: channels bounded tighter than their quantity: an arm or slip angle turns less than a turn
+COLUMN_LIMITS: dict[str, float] = {"suspension_angle_rad": 2 * math.pi,
+                                   "slip_angle_rad": 2 * math.pi}
+
