@@ -11,9 +11,11 @@ with :mod:`fitting`), the load-interpolation checks, and the data of the optiona
 
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass, field
 from datetime import datetime
+from pathlib import Path
 from typing import Any
 
 import pandas as pd
@@ -112,6 +114,8 @@ class CampaignData:
     validation: dict[SetKey, tuple[float, list[ValidationResult]]]
     provenance: tuple[str, str]
     extras: dict[str, Any] = field(default_factory=dict)
+    #: runs of the campaign's folder that failed: (run id or file name, stage, reason)
+    failed: list[tuple[str, str, str]] = field(default_factory=list)
 
     @property
     def loads(self) -> list[float]:
@@ -302,4 +306,16 @@ def gather(session: Session, name: str, db_url: str | None = None) -> CampaignDa
                          curves=_curves(session, campaign.id, results),
                          provenance=("database", where))
     data.extras = gather_extras(session, data)
+    data.failed = failed_runs(session, results)
     return data
+
+
+def failed_runs(session: Session, results: pd.DataFrame) -> list[tuple[str, str, str]]:
+    """The failed runs (newest outcome a failure) whose file lies in the campaign's folder
+    (the folder holding all its raw files): (run id or file name, stage, reason)."""
+    from traceability.store_failures import current_failures
+
+    folders = {str(Path(p).parent) for p in results["raw_file_path"]}
+    root = Path(os.path.commonpath(sorted(folders))) if folders else None
+    return [(f.run_id or Path(f.path).name, f.stage, f.error) for f in current_failures(session)
+            if root is not None and Path(f.path).is_relative_to(root)]

@@ -59,12 +59,19 @@ def runs_section(data: CampaignData) -> Section:
             _with_u95(run, "torque_nm"), _with_u95(run, "sinkage_m", 1000.0, 3),
             "; ".join(run.flags)])
         classes.append(run.status)
+    for run_id, stage, reason in data.failed:
+        rows.append([escape(run_id), "", "", "", "", "", '<span class="status failed">failed'
+                     '</span>', "none", "", "", "", "", f"{stage} failed: {reason}"])
+        classes.append("failed")
     counts = {s: sum(r.status == s for r in data.runs) for s in ("ok", "flagged",
                                                                    "no_stable_phase")}
-    summary = (f"{len(data.runs)} runs: {counts['ok']} ok, {counts['flagged']} flagged (a check "
-               f"failed; kept out of the fits), {counts['no_stable_phase']} without a stable "
-               "phase. Means over the stable window ± their 95 % expanded uncertainty (the run's "
-               "uncertainty budget, docs/run-results.md); a run id opens its time series.")
+    summary = (f"{len(data.runs) + len(data.failed)} runs: {counts['ok']} ok, "
+               f"{counts['flagged']} flagged (a check failed; kept out of the fits), "
+               f"{counts['no_stable_phase']} without a stable phase"
+               + (f", {len(data.failed)} failed (could not be processed; the reason says why)"
+                  if data.failed else "")
+               + ". Means over the stable window ± their 95 % expanded uncertainty (the run's "
+                 "uncertainty budget, docs/run-results.md); a run id opens its time series.")
     return Section(RUNS, "Runs", [Note(summary), Table(
         header, rows, numeric=frozenset({2, 3, 4, 5, 8, 9, 10, 11}), row_classes=classes,
         html_columns=frozenset({0, 6}))])

@@ -12,6 +12,12 @@ Runs are processed outside any transaction and stored under the database's write
 Versions (docs/results.md): a changed file is its run's new current version, another file
 claiming a stored run_id is refused unless ``--allow-run-id-reuse``, and stored files gone
 from CAMPAIGN are marked missing.
+
+A run that fails at any stage (it cannot be read, its results cannot be computed, the
+database refuses it) is listed with file, stage and reason, recorded (``swtlab results``
+shows it as ``failed``) and the batch goes on. Exit 0 when at least one run was processed
+or already up to date, 3 when none could be, 4 only for a fault outside any run (the
+database cannot be opened, for one).
 """
 
 from __future__ import annotations
@@ -24,7 +30,6 @@ from pathlib import Path
 from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
 from swtlab_cli.progress import progress
-
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -56,7 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import ingest
-    from swtlab.pipeline.database import store_processed
+    from swtlab.pipeline.database import store_one
     from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
                                          process_file, rig_compliance)
     from traceability import open_database
@@ -84,10 +89,13 @@ def run(args: argparse.Namespace) -> int:
     flows = up_to_date = 0
     new: list[tuple] = []   # (path, sha256, result) stored now: their drift is pooled below
     for path in progress(paths, desc="process", quiet=args.quiet):
-        sha256, _ = content_sha256(path)
+        try:
+            sha256, _ = content_sha256(path)
+        except OSError:
+            sha256 = None  # unreadable: process_file records why
 
         def known(session, path=path, sha256=sha256):
-            if not processed_file(session, path, sha256, params_hash):
+            if sha256 is None or not processed_file(session, path, sha256, params_hash):
                 return None
             failure = stored_flow_failure(session, path, sha256, params_hash)
             return [] if failure is None else [f"{path}: {failure.channel}: {failure.problem}"]
@@ -98,13 +106,14 @@ def run(args: argparse.Namespace) -> int:
             flow_failed += known_flow_failures
             continue
         processed = process_file(path, settings)  # outside any transaction: no lock held
-        stored = in_transaction(session_factory, lambda session, p=processed: store_processed(
-            session, p, parameters, allow_run_id_reuse=args.allow_run_id_reuse))
-        failed += [f.reason for f in processed.failures if f.stage != "soil_flow"]
-        if processed.result is None:
+        stored = store_one(session_factory, processed, parameters,
+                           allow_run_id_reuse=args.allow_run_id_reuse)
+        failed += [f.reason if f.error_type == "IngestError" else f"{f.file}: {f.stage}: {f.reason}"
+                   for f in processed.failures if f.stage != "soil_flow"]
+        if processed.result is None or any(f.stage == "store" for f in processed.failures):
             continue
         if not stored:
-            up_to_date += not any(f.stage == "store" for f in processed.failures)
+            up_to_date += 1
             continue
         result = processed.result
         new.append((path, sha256, result))

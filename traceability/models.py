@@ -149,13 +149,18 @@ class Calibration(Base):
 
 
 class IngestFailure(Base):
-    """A file that could not be read, with its one-line reason (a batch report lists it)."""
+    """A file that could not be processed, with its one-line reason (a batch report lists it):
+    the ``stage`` that failed (``ingest``, ``results``, ``store``), the exception's class
+    ``error_type`` and the run's ``run_id`` where ingest got that far."""
 
     __tablename__ = "ingest_failure"
     id: Mapped[int] = mapped_column(primary_key=True)
     path: Mapped[str] = mapped_column(String(PATH_CHARS))
     sha256: Mapped[str] = mapped_column(String(64))
     error: Mapped[str] = mapped_column(String(MESSAGE_CHARS))
+    stage: Mapped[str] = mapped_column(String(20), default="ingest")
+    error_type: Mapped[str | None] = mapped_column(String(100), nullable=True)
+    run_id: Mapped[str | None] = mapped_column(String(NAME_CHARS), nullable=True)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
 
     processing: Mapped[ProcessingRecord] = relationship()

@@ -13,11 +13,9 @@ from sqlalchemy.orm import Session
 from plain_json import jsonable
 from swtlab.domain.results import UNCERTAINTY_TERMS
 from traceability.provenance import swtlab_version
-from traceability.models import (IngestFailure, RawFile, Run, RunQuantity, RunResult,
-                                 RunUncertainty, StableWindow)
+from traceability.models import RawFile, Run, RunQuantity, RunResult, RunUncertainty, StableWindow
 from traceability.store import new_processing_record
 from traceability.store_traces import store_traces
-from traceability.text import message
 
 
 def params_sha256(parameters: dict[str, Any]) -> str:
@@ -91,17 +89,6 @@ def store_uncertainty(session: Session, row: RunResult, budgets: dict) -> None:
             not_measured=list(d["not_measured"]),
             **{k: _num(d[k]) for k in ("correction", *(f"u_{t}" for t in UNCERTAINTY_TERMS),
                                        "u", "dof", "k", "u95")}))
-
-
-def store_ingest_failure(session: Session, path: Path, sha256: str, error: str,
-                         parameters: dict[str, Any]) -> None:
-    """Record a file that could not be read or stored (once per path, content and message)."""
-    error = message(error)
-    known = session.scalars(select(IngestFailure).filter_by(
-        path=str(path.resolve()), sha256=sha256, error=error)).first()
-    if known is None:
-        session.add(IngestFailure(path=str(path.resolve()), sha256=sha256, error=error,
-                                  processing=new_processing_record(session, "ingest", parameters)))
 
 
 def _num(value: Any) -> float | None:

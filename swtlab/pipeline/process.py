@@ -88,11 +88,10 @@ def _soil_flow(done: ProcessedRun, settings: ProcessSettings) -> None:
     try:
         flow = run_flow(done.run, window.start_s, window.end_s, settings.max_frames)
     except FlowRunError as error:
-        done.failures.append(Failure(str(done.path), "soil_flow", error.problem))
+        done.failures.append(Failure(str(done.path), "soil_flow", error.problem, "FlowRunError"))
         return
     except Exception as error:  # noqa: BLE001 - one run's camera must not stop the batch
-        done.failures.append(Failure(str(done.path), "soil_flow", "internal error in the flow "
-                                     f"analysis ({type(error).__name__}: {error})"))
+        done.failures.append(Failure.of(done.path, "soil_flow", error))
         return
     if flow is not None:
         done.flow, done.flow_npz = flow, pack_flow(flow.result, flow.first_frame)
@@ -108,25 +107,20 @@ def process_file(path: Path, settings: ProcessSettings) -> ProcessedRun:
     from traceability.hashing import content_sha256
 
     path = Path(path)
-    done = ProcessedRun(path=path, sha256=content_sha256(path)[0])
+    done = ProcessedRun(path=path, sha256="")
     try:
+        done.sha256 = content_sha256(path)[0]
         done.run = ingest.read_run(path, channel_map=settings.channel_map)
         done.streams = report(done.run)["streams"]
-    except ingest.IngestError as error:
-        done.run = None
-        done.failures.append(Failure(str(path), "ingest", str(error)))
-        return done
     except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
         done.run = None
-        done.failures.append(Failure(str(path), "ingest",
-                                     f"internal error ({type(error).__name__}: {error})"))
+        done.failures.append(Failure.of(path, "ingest", error))
         return done
     try:
         done.result = process_run(done.run, settings.stable, settings.rig,
                                   run_image_slip(done.run), settings.budget)
     except Exception as error:  # noqa: BLE001
-        done.failures.append(Failure(str(path), "results",
-                                     f"internal error ({type(error).__name__}: {error})"))
+        done.failures.append(Failure.of(path, "results", error))
         return done
     _soil_flow(done, settings)
     return done
