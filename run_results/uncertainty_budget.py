@@ -11,9 +11,13 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   which stops at the first negative pair, counts that noise in full and still ends before
   a slow ripple of the drives is seen.
 - ``zero_drift``: the load cells' zero at the window, from the rest readings
-  (``run_results.rest_readings``). DP, torque and side force read zero at rest, ``fz`` the
-  set load (raw-run spec); the zero is taken as linear in time between the two rests and
-  subtracted (the ``correction``, GUM 3.2.3). Its uncertainty: the rests' SEs, and the drift's
+  (``run_results.rest_readings``). DP, torque and side force read zero at rest; the zero is
+  taken as linear in time between the two rests and subtracted (the ``correction``, GUM
+  3.2.3). ``fz`` carries the wheel's actual load at rest, which is what it measures, so only
+  its change between the rests is drift: the line starts at zero at the first rest (the
+  spec's ``swt.zero`` stays its absolute zero; taking the set load as the rest value would
+  make the measured load equal the set load by construction, and hide a saturated cell).
+  Its uncertainty: the rests' SEs, and the drift's
   departure from the line over the window, modelled as a Brownian bridge between the rests
   (variance ``beta sigma^2 T`` of its window mean, :func:`bridge_factor`). The diffusion
   ``sigma^2`` of each cell is pooled over the runs of a campaign from their changes between
@@ -21,9 +25,9 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   freedom per run, GUM 4.2.4); a run alone has only its own ``D^2 / T``, one degree of freedom.
   Without two rests nothing is subtracted and the term is listed as not measured
   (``swt.zero`` alone says nothing about the drift since the zeroing).
-- ``calibration``: ``gain_rel_u`` times what the gain scales (the mean; for ``fz`` re-zeroed
-  on the set load, the mean's difference from it) and, where the zero is not re-measured,
-  ``offset_u`` (the spec's optional ``swt.calibration`` keys; not stated: not measured).
+- ``calibration``: ``gain_rel_u`` times what the gain scales (the mean) and, where the
+  zero is not re-measured (``fz``, or no rests), ``offset_u`` (the spec's optional
+  ``swt.calibration`` keys; not stated: not measured).
 - ``quantisation``: of a step ``q`` read from the samples, ``q/sqrt(12)`` damped by
   ``exp(-2 pi^2 s^2 / q^2)`` for samples spread by ``s`` (dithered by their own noise: the
   first harmonic of the quantiser's mean error for Gaussian input, Widrow, Kollar & Liu 1996,
@@ -191,7 +195,10 @@ def rect_normal_quantile(a: float, sigma: float, p: float = 0.975) -> float:
     def cdf(x: float) -> float:
         g = lambda z: z * stats.norm.cdf(z) + stats.norm.pdf(z)  # noqa: E731
         return sigma / (2 * a) * (g((x + a) / sigma) - g((x - a) / sigma)) - p
-    return float(optimize.brentq(cdf, 0.0, a + 10 * sigma))
+    hi = a + 10 * sigma
+    if not cdf(hi) > 0:  # sigma so small against a that the difference cancels: rectangular
+        return a * (2 * p - 1)
+    return float(optimize.brentq(cdf, 0.0, hi))
 
 
 def combine(terms: list[Term]) -> tuple[float, float, float]:
@@ -227,15 +234,17 @@ class ZeroAtWindow:
 
 
 def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[float, float],
-                   rest_value: float) -> ZeroAtWindow:
+                   rest_value: float | None) -> ZeroAtWindow:
     """The zero of ``column`` over the window: the rests' means less ``rest_value`` (what the
-    cell carries at rest), linear in time between the rests, with its uncertainty (module doc)."""
+    cell carries at rest; None: not known, only the change since the first rest is drift),
+    linear in time between the rests, with its uncertainty (module doc)."""
     if rests is None or column not in rests.before or column not in rests.after:
         return ZeroAtWindow(0.0, None, "zero drift (no rest readings before and after the drive)")
     b, a = rests.before[column], rests.after[column]
     span = a.t_s - b.t_s
     w = ((window_s[0] + window_s[1]) / 2 - b.t_s) / span
-    d0, d1 = b.stats.mean - rest_value, a.stats.mean - rest_value
+    reference = b.stats.mean if rest_value is None else rest_value
+    d0, d1 = b.stats.mean - reference, a.stats.mean - reference
     zero = d0 + (d1 - d0) * w
     means = _rss([Term((1 - w) * b.stats.se, max(b.stats.n_eff - 1, 1)),
                   Term(w * a.stats.se, max(a.stats.n_eff - 1, 1))])
@@ -293,8 +302,8 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
     """Budget of a single-cell quantity (thrust: the torque cell over the radius)."""
     column, per_radius = CELL_OF[key]
     scale = run.metadata.wheel.radius_m if per_radius else 1.0
-    at_rest = run.metadata.run.load_n if column == "fz_n" else 0.0
-    z = zero_at_window(rests, column, window_s, at_rest)
+    absolute = column != "fz_n"  # fz at rest reads the actual load, which it measures
+    z = zero_at_window(rests, column, window_s, 0.0 if absolute else None)
     missing = [] if z.missing is None else [z.missing]
     terms = {"statistical": _statistical(s)}
     drift = () if z.part is None else (replace(z.part, weight=1.0 / scale),)
@@ -303,9 +312,8 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
     if gain_u is None:
         missing.append("calibration (no gain_rel_u / offset_u in swt.calibration)")
     else:
-        scaled = abs(mean - at_rest / scale) if drift else abs(mean)
-        offset = 0.0 if drift else offset_u / scale
-        terms["calibration"] = Term(math.hypot(gain_u * scaled, offset))
+        offset = 0.0 if drift and absolute else offset_u / scale
+        terms["calibration"] = Term(math.hypot(gain_u * abs(mean), offset))
     native = channel_samples(run, column, *window_s)
     if native is not None:
         terms["quantisation"] = Term(_quantisation(resolution(native[1]) / scale, s.std))

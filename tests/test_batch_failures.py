@@ -130,11 +130,11 @@ def test_a_run_the_database_refuses_is_a_failure_of_stage_store(folder, tmp_path
 
     real = database.store_processed
 
-    def refuse(session, done, parameters):
+    def refuse(session, done, parameters, **options):
         if done.path.name == "c_still_wheel.mcap":
-            real(session, done, parameters)
+            real(session, done, parameters, **options)
             raise ValueError("the database refuses this run")
-        return real(session, done, parameters)
+        return real(session, done, parameters, **options)
 
     monkeypatch.setattr(database, "store_processed", refuse)
     url = f"sqlite:///{tmp_path / 'swtlab.sqlite'}"

@@ -3,6 +3,7 @@ virtual-testbed run with one channel or metadata value changed in its MCAP bytes
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +12,8 @@ import pytest
 import ingest
 from bench.mcap_content import read_content, write_content
 from run_results import process_run
+from run_results.plausibility import plausibility_flags
+from stable_phase import StablePhaseParams
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
 GOOD = SAMPLE / "L180_MP0_SC_s+020.mcap"   # speed control, 180 N, no DP calibration record
@@ -132,21 +135,21 @@ def test_a_wheel_that_never_turns_is_flagged(tmp_path):
 
 
 def test_a_dig_in_with_a_flat_tail_is_flagged(tmp_path):
-    """DP rises by a bump 100 exp(-((t - 12)/6)^2) N and falls back to its level well before
-    the stable window (29-57 s in truth): the tail is flat, the run dug in. Seen through a
-    moving mean over one grouser period T, the bump's peak is
-    100 sqrt(pi) 6 erf(T/12) / T N above the level."""
+    """DP rises by a bump 100 exp(-((t - 15)/4)^2) N and falls back to its level well before
+    the stable window (29-57 s in truth), clear of the rest readings (before 3 s): the tail
+    is flat, the run dug in. Seen through a moving mean over one grouser period T, the
+    bump's peak is 100 sqrt(pi) 4 erf(T/8) / T N above the level."""
     from math import erf, pi, sqrt
 
     _, plain = _process(tmp_path)
-    bump = lambda t, y: y + 100.0 * np.exp(-(((t - 12.0) / 6.0) ** 2))  # noqa: E731
+    bump = lambda t, y: y + 100.0 * np.exp(-(((t - 15.0) / 4.0) ** 2))  # noqa: E731
     _, result = _process(tmp_path, lambda c: _map_field(c, "/tether/force", ("dp",), bump))
     assert result.window.found and result.window.start_s > 25.0
     (flag,) = _flags(result, "dig-in: drawbar pull rose")
     level = plain.quantities["dp_n"].mean
     assert result.quantities["dp_n"].mean == pytest.approx(level, abs=1.0)
     period = result.window.diagnostics["grouser_period_s"]
-    expected = level + 100.0 * sqrt(pi) * 6.0 * erf(period / 12.0) / period
+    expected = level + 100.0 * sqrt(pi) * 4.0 * erf(period / 8.0) / period
     peak = float(flag.split("rose to ")[1].split(" N")[0])
     assert peak == pytest.approx(expected, abs=3.0)
     assert plain.flags == () and result.status == "flagged"
@@ -171,17 +174,23 @@ def test_sinkage_growing_through_the_first_window_is_a_dig_in(tmp_path):
     assert 0.5 < grown_mm <= 4.0 and result.status == "flagged"
 
 
-def test_a_torque_zero_far_off_gives_a_thrust_no_soil_can_and_is_flagged(tmp_path):
-    """swt.zero.ty = 500 N*m instead of its own zero z0: the torque drops by 500 - z0, the
-    thrust T/r by (500 - z0)/0.125, about -3900 N against a 180 N load (found by the fuzzer,
-    stored as ok before)."""
+def test_a_torque_zero_far_off_is_repaired_by_the_rests_and_flagged_without_them(tmp_path):
+    """swt.zero.ty = 500 N*m instead of its own zero z0 (found by the fuzzer, stored as ok
+    before): the rest readings re-measure the torque's zero, so the thrust is the plain
+    run's and the correction the shift; the thrust the bad zero gives without rests, about
+    -3900 N against a 180 N load, is flagged."""
     plain_run, plain = _process(tmp_path)
     run, result = _process(tmp_path, metadata={("zero", "ty"): "500"})
     shift_nm = 500.0 - plain_run.metadata.zero["ty"]
-    expected = (plain.quantities["torque_nm"].mean - shift_nm) / run.metadata.wheel.radius_m
-    assert result.quantities["thrust_n"].mean == pytest.approx(expected, rel=1e-3)
-    (flag,) = _flags(result, "thrust T/r")
-    assert "over 1.5 times the wheel load" in flag and result.status == "flagged"
+    assert result.quantities["thrust_n"].mean == pytest.approx(
+        plain.quantities["thrust_n"].mean, abs=0.5)
+    assert result.uncertainty["torque_nm"].correction == pytest.approx(shift_nm, rel=1e-3)
+    thrust = (plain.quantities["torque_nm"].mean - shift_nm) / run.metadata.wheel.radius_m
+    unrepaired = {**result.quantities,
+                  "thrust_n": replace(result.quantities["thrust_n"], mean=thrust)}
+    flags = plausibility_flags(run, result.window, unrepaired, StablePhaseParams())
+    assert any(f.startswith("thrust T/r") and "over 1.5 times the wheel load" in f
+               for f in flags)
 
 
 def test_electrical_spikes_are_flagged(tmp_path):

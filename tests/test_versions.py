@@ -66,7 +66,10 @@ def test_another_file_claiming_a_run_id_is_refused_unless_allowed(tmp_path, db_u
     refusal = next(line for line in out.splitlines() if "claims run_id" in line)
     assert str(other) in refusal and str(first) in refusal and "--allow-run-id-reuse" in refusal
     assert "1 failed" in out
-    (row,) = _results(db_url, capsys)
+    rows = _results(db_url, capsys)  # the refused file is listed as failed, of stage store
+    (row,) = [r for r in rows if r["status"] != "failed"]
+    (refused,) = [r for r in rows if r["status"] == "failed"]
+    assert (refused["raw_file_path"], refused["failure_stage"]) == (str(other), "store")
     assert (row["raw_file_path"], row["load_set_n"]) == (str(first), 180.0)
     assert _count(db_url, RawFile) == 1
 
