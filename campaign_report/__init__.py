@@ -10,7 +10,7 @@ load-interpolation check, the exported WPM curves, and the sections registered i
 :mod:`campaign_report.extensions` that have data. See docs/report.md.
 """
 
-from campaign_report import flow, gap, image_slip  # noqa: F401 - register their sections
+from campaign_report import flow, gap, image_slip, replicates  # noqa: F401 - their sections
 from campaign_report.data import CampaignData, from_results, gather
 from campaign_report.render import page_paths, render_report, write_report, write_reports
 

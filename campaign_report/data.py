@@ -11,9 +11,11 @@ with :mod:`fitting`), the load-interpolation checks, and the data of the optiona
 
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass, field
 from datetime import datetime
+from pathlib import Path
 from typing import Any
 
 import pandas as pd
@@ -57,6 +59,8 @@ class RunRecord:
     dp_trace: dict | None
     traces: dict[str, Trace] | None  # None: not stored (processed before migration 0006)
     means: dict[str, float] = field(default_factory=dict)
+    #: quantity -> 95 % expanded uncertainty of the mean (the run's budget)
+    u95: dict[str, float] = field(default_factory=dict)
 
     @classmethod
     def from_result(cls, result: ProcessedRun) -> RunRecord:
@@ -71,7 +75,9 @@ class RunRecord:
                    window_end_s=_none_if_nan(w.end_s) if w.found else None,
                    dp_trace=result.dp_trace, traces=dict(result.traces),
                    means={k: float(q.mean) for k, q in result.quantities.items()
-                          if _none_if_nan(q.mean) is not None})
+                          if _none_if_nan(q.mean) is not None},
+                   u95={k: float(b.u95) for k, b in result.uncertainty.items()
+                        if _none_if_nan(b.u95) is not None})
 
 
 @dataclass(frozen=True)
@@ -108,6 +114,8 @@ class CampaignData:
     validation: dict[SetKey, tuple[float, list[ValidationResult]]]
     provenance: tuple[str, str]
     extras: dict[str, Any] = field(default_factory=dict)
+    #: runs of the campaign's folder that failed: (run id or file name, stage, reason)
+    failed: list[tuple[str, str, str]] = field(default_factory=list)
 
     @property
     def loads(self) -> list[float]:
@@ -171,7 +179,9 @@ def _run_records(session: Session, results: pd.DataFrame) -> list[RunRecord]:
             window_end_s=_none_if_nan(row["window_end_s"]), dp_trace=more.dp_trace,
             traces=traces.get(int(row["result_id"])),
             means={c.removesuffix("_mean"): v for c in means
-                   if (v := _none_if_nan(row[c])) is not None}))
+                   if (v := _none_if_nan(row[c])) is not None},
+            u95={c.removesuffix("_u95"): v for c in row
+                 if c.endswith("_u95") and (v := _none_if_nan(row[c])) is not None}))
     return runs
 
 
@@ -296,4 +306,16 @@ def gather(session: Session, name: str, db_url: str | None = None) -> CampaignDa
                          curves=_curves(session, campaign.id, results),
                          provenance=("database", where))
     data.extras = gather_extras(session, data)
+    data.failed = failed_runs(session, results)
     return data
+
+
+def failed_runs(session: Session, results: pd.DataFrame) -> list[tuple[str, str, str]]:
+    """The failed runs (newest outcome a failure) whose file lies in the campaign's folder
+    (the folder holding all its raw files): (run id or file name, stage, reason)."""
+    from traceability.store_failures import current_failures
+
+    folders = {str(Path(p).parent) for p in results["raw_file_path"]}
+    root = Path(os.path.commonpath(sorted(folders))) if folders else None
+    return [(f.run_id or Path(f.path).name, f.stage, f.error) for f in current_failures(session)
+            if root is not None and Path(f.path).is_relative_to(root)]

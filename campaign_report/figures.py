@@ -13,7 +13,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from campaign_report.data import RunRecord, SetKey
-from campaign_report.style import CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette
+from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
+                                   plain_text)
 from fitting import CurveFit, ValidationResult, curves_by_load, interpolate_load
 from run_results.traces import TRACE_QUANTITIES
 from sim_gap.vocabulary import SLIP_BAND_EDGES, slip_band_labels
@@ -77,11 +78,11 @@ def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
         labelled.update(zip(*reversed(ax.get_legend_handles_labels())))
     fig.legend(labelled.values(), labelled.keys(), loc="lower center", ncols=len(labelled),
                frameon=False, fontsize="small")
-    title = (f"{run.run_id}: {run.mode}, {run.load_n:g} N, multipass {run.multipass}"
+    title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass {run.multipass}"
              + (f", slip set {100 * run.slip_setpoint:g} %" if run.slip_setpoint is not None
                 else ""))
     if run.status == "no_stable_phase":
-        reason = "; ".join(run.flags)
+        reason = plain_text("; ".join(run.flags))
         title += "\n" + "\n".join(textwrap.wrap(reason, 110))
     fig.suptitle(title, fontsize="medium",
                  color="#a00000" if run.status != "ok" else "k")
@@ -136,7 +137,8 @@ def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, s
         handles.append(Line2D([], [], ls="", marker="o", color="0.3", mfc="white",
                               label="flagged, not fitted"))
     fig.legend(handles=handles, loc="outside right upper", title="load, soil pass")
-    fig.suptitle(f"{wheel} on {soil}: means ± standard error, fitted polynomials",
+    fig.suptitle(f"{plain_text(wheel)} on {plain_text(soil)}: means ± standard error, "
+                 "fitted polynomials",
                  fontsize="medium")
     return fig
 
@@ -172,7 +174,8 @@ def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, loa
                          fontsize="medium")
     fig.legend(handles=palette.legend_handles([*sets.get((*key, "dp_n"), {}), load_n], [mp]),
                loc="outside right upper", title="load")
-    fig.suptitle(f"{key[0]} on {key[1]}, multipass {mp}: curves interpolated to "
+    fig.suptitle(f"{plain_text(key[0])} on {plain_text(key[1])}, multipass {mp}: curves "
+                 "interpolated to "
                  f"{load_n:g} N against the {load_n:g} N runs (not used in the fits)",
                  fontsize="medium")
     return fig
@@ -199,7 +202,8 @@ def wpm_curves(wpm: WheelPerformanceModule, tested: dict[str, list[float]], soil
     handles = palette.legend_handles([x for q in quantities for x in tested[q]], [multipass])
     handles.append(Line2D([], [], color="0.6", ls=":", label="between (WPM runtime)"))
     fig.legend(handles=handles, loc="outside right upper", title="load")
-    fig.suptitle(f"WPM curves as exported: {wheel} on {soil}, multipass {multipass}",
+    fig.suptitle(f"WPM curves as exported: {plain_text(wheel)} on {plain_text(soil)}, "
+                 f"multipass {multipass}",
                  fontsize="medium")
     return fig
 

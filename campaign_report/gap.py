@@ -23,7 +23,7 @@ from campaign_report.extensions import Extension, register
 from campaign_report.figures import condition_text, gap_heatmap, slip_band_text, varying_factors
 from campaign_report.html import Block, Heading, Image, Note, Page, Section, Table, render_page
 from campaign_report.images import to_png
-from campaign_report.render import write_text_atomically
+from swtlab.atomic import write_atomically
 from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, value_text
 from sim_gap.vocabulary import slip_band_labels
 from traceability.models import GapReport
@@ -354,7 +354,7 @@ def gap_page(report: dict) -> Page:
 
 def write_gap_page(report: dict, path: str | Path) -> Path:
     """Write :func:`gap_page` of ``report`` to ``path`` (atomically)."""
-    return write_text_atomically(render_page(gap_page(report)), path)
+    return write_atomically(path, render_page(gap_page(report)))
 
 
 register(Extension(NAME, gap_section, gather_gap))

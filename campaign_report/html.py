@@ -21,9 +21,9 @@ nav{margin:.6em 0 1em}nav a{margin-right:1em}
 table{border-collapse:collapse;font-size:13px;width:100%}table+table{margin-top:1em}
 th,td{border-bottom:1px solid #e3e3e3;padding:3px 6px;text-align:left;vertical-align:top}
 th{background:#f3f5f8;position:sticky;top:0}td.num{text-align:right;white-space:nowrap}
-tr.flagged td{background:#fff6df}tr.no_stable_phase td{background:#fde8e8}
+tr.flagged td{background:#fff6df}tr.no_stable_phase td,tr.failed td{background:#fde8e8}
 .status{font-weight:600;white-space:nowrap}.status.ok{color:#1a7f37}
-.status.flagged{color:#9a6700}.status.no_stable_phase{color:#b42318}
+.status.flagged{color:#9a6700}.status.no_stable_phase,.status.failed{color:#b42318}
 .note{padding:6px 10px;border-left:4px solid #0072B2;background:#f3f8fc;margin:.6em 0}
 .note.warning{border-color:#D55E00;background:#fdf1e9}
 .gallery{display:grid;grid-template-columns:repeat(auto-fill,minmax(300px,1fr));gap:12px}

@@ -3,9 +3,7 @@ the database or from in-memory results), figures drawn, page assembled, file wri
 
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 from collections.abc import Callable, Iterable
 from datetime import UTC, datetime
 from pathlib import Path
@@ -15,6 +13,7 @@ from campaign_report.data import CampaignData, campaign_names, gather
 from campaign_report.extensions import optional_sections
 from campaign_report.html import Page, render_page
 from campaign_report.style import Palette
+from swtlab.atomic import write_atomically
 from traceability import open_database
 from traceability.provenance import swtlab_version
 
@@ -67,26 +66,7 @@ def build_page(data: CampaignData, progress: Progress = _no_progress) -> Page:
 def render_report(data: CampaignData, path: str | Path,
                   progress: Progress = _no_progress) -> Path:
     """Write the page of ``data`` to ``path`` (atomically: a reader never sees half a page)."""
-    return write_text_atomically(render_page(build_page(data, progress)), path)
-
-
-def write_text_atomically(text: str, path: str | Path) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder, so a
-    reader never sees half a page."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)  # as an ordinary file, not mkstemp's 0600
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-    return path
+    return write_atomically(path, render_page(build_page(data, progress)))
 
 
 def write_report(db_url: str, path: str | Path, campaign: str | None = None,
@@ -95,7 +75,7 @@ def write_report(db_url: str, path: str | Path, campaign: str | None = None,
 
     Raises ``LookupError`` (one line, what to do) when the database has no processed run,
     no such campaign, or several campaigns and none was named."""
-    with open_database(db_url)() as session:
+    with open_database(db_url, read_only=True)() as session:
         names = campaign_names(session)
         if not names:
             raise LookupError(f"{db_url}: no processed runs (run swtlab process first)")
@@ -112,7 +92,7 @@ def write_report(db_url: str, path: str | Path, campaign: str | None = None,
 def write_reports(db_url: str, path: str | Path,
                   progress: Progress = _no_progress) -> dict[str, Path]:
     """One page per campaign of the database, named by :func:`page_paths`: campaign -> page."""
-    with open_database(db_url)() as session:
+    with open_database(db_url, read_only=True)() as session:
         names = campaign_names(session)
     if not names:
         raise LookupError(f"{db_url}: no processed runs (run swtlab process first)")

@@ -29,6 +29,14 @@ def _number(value: float | None, scale: float = 1.0, digits: int = 4) -> str:
     return "" if value is None else f"{value * scale:.{digits}g}"
 
 
+def _with_u95(run: RunRecord, key: str, scale: float = 1.0, digits: int = 4) -> str:
+    """``mean ± u95`` of a quantity (the mean alone where the run has no budget for it)."""
+    mean, u95 = run.means.get(key), run.u95.get(key)
+    if mean is None or u95 is None:
+        return _number(mean, scale, digits)
+    return f"{_number(mean, scale, digits)} ± {u95 * scale:.2g}"
+
+
 def _window(run: RunRecord) -> str:
     if run.window_start_s is None or run.window_end_s is None:
         return "none"
@@ -42,21 +50,28 @@ def runs_section(data: CampaignData) -> Section:
               "sinkage [mm]", "flags and reasons"]
     rows, classes = [], []
     for i, run in enumerate(data.runs):
-        m = run.means
         rows.append([
             f'<a href="#full-{run_anchor(i)}">{escape(run.run_id)}</a>', run.mode,
             f"{run.load_n:g}", str(run.multipass), _number(run.slip_setpoint, 100.0, 3),
             _number(run.velocity_mps, 1000.0, 3),
             f'<span class="status {escape(run.status)}">{escape(run.status)}</span>', _window(run),
-            _number(m.get("slip"), 100.0, 3), _number(m.get("dp_n")),
-            _number(m.get("torque_nm")), _number(m.get("sinkage_m"), 1000.0, 3),
+            _with_u95(run, "slip", 100.0, 3), _with_u95(run, "dp_n"),
+            _with_u95(run, "torque_nm"), _with_u95(run, "sinkage_m", 1000.0, 3),
             "; ".join(run.flags)])
         classes.append(run.status)
+    for run_id, stage, reason in data.failed:
+        rows.append([escape(run_id), "", "", "", "", "", '<span class="status failed">failed'
+                     '</span>', "none", "", "", "", "", f"{stage} failed: {reason}"])
+        classes.append("failed")
     counts = {s: sum(r.status == s for r in data.runs) for s in ("ok", "flagged",
                                                                    "no_stable_phase")}
-    summary = (f"{len(data.runs)} runs: {counts['ok']} ok, {counts['flagged']} flagged (a check "
-               f"failed; kept out of the fits), {counts['no_stable_phase']} without a stable "
-               "phase. Means over the stable window; a run id opens its time series.")
+    summary = (f"{len(data.runs) + len(data.failed)} runs: {counts['ok']} ok, "
+               f"{counts['flagged']} flagged (a check failed; kept out of the fits), "
+               f"{counts['no_stable_phase']} without a stable phase"
+               + (f", {len(data.failed)} failed (could not be processed; the reason says why)"
+                  if data.failed else "")
+               + ". Means over the stable window ± their 95 % expanded uncertainty (the run's "
+                 "uncertainty budget, docs/run-results.md); a run id opens its time series.")
     return Section(RUNS, "Runs", [Note(summary), Table(
         header, rows, numeric=frozenset({2, 3, 4, 5, 8, 9, 10, 11}), row_classes=classes,
         html_columns=frozenset({0, 6}))])

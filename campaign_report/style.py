@@ -8,6 +8,13 @@ from dataclasses import dataclass
 
 from matplotlib.lines import Line2D
 
+def plain_text(text: str) -> str:
+    """``text`` from a raw file or the database (run id, wheel, soil, flags) as matplotlib
+    draws it literally: every ``$`` escaped, so a pair of them never starts math text (a run
+    id like ``run $\\frac{$ x`` would make the mathtext parser fail the whole figure)."""
+    return str(text).replace("$", r"\$")
+
+
 #: colour-blind-safe (Okabe & Ito 2008), assigned to the campaign's loads in rising order
 LOAD_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442",
                 "#000000")

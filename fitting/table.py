@@ -11,6 +11,7 @@ import pandas as pd
 from fitting.curve import QUANTITY_UNITS, CurveFit
 from fitting.errors import FittingError, TooFewPointsError
 from fitting.fit import check_degree, fit_curve
+from swtlab.domain.replicates import fit_sigma
 
 KEY_COLUMNS = ("wheel", "soil", "multipass", "load_n")
 MEASURED = ("dp_n", "torque_nm", "sinkage_m", "resistance_n")
@@ -23,11 +24,16 @@ def from_run_results(results: pd.DataFrame, statuses: Iterable[str] = ("ok",)) -
     ``<q>_se``) in the columns the fits read: ``load_n`` and ``<q>``/``<q>_se`` for slip,
     wheel load and the measured quantities; only runs whose ``status`` is in ``statuses``
     (default: ``ok``) and that are not steered. Other columns (``run_id``,
-    ``raw_file_sha256`` ...) are kept for the trace."""
+    ``raw_file_sha256`` ...) are kept for the trace. ``<q>_se`` becomes the fit's sigma of
+    each run: the larger of its uncertainty (``<q>_u`` of the budget, else its SE) and the
+    spread of its replicates (``swtlab.domain.replicates.fit_sigma``)."""
     keep = results["status"].isin(list(statuses))
     if "mode" in results:
         keep &= results["mode"] != "steered"
-    out = results[keep].rename(columns={"load_set_n": "load_n"})
+    out = results[keep]
+    out = out.assign(**{f"{q}_se": fit_sigma(out, q) for q in ("slip", "wheel_load_n") + MEASURED
+                        if f"{q}_se" in out or f"{q}_u" in out})
+    out = out.rename(columns={"load_set_n": "load_n"})
     for q in ("slip", "wheel_load_n") + MEASURED:
         if f"{q}_mean" in out:
             out = out.rename(columns={f"{q}_mean": q})

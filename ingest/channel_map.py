@@ -145,6 +145,54 @@ def _check_keys(path: Path, where: str, table: dict, known: set[str]) -> None:
         raise _fail(path, where, f"unknown key {unknown[0]!r}; known: {', '.join(sorted(known))}")
 
 
+#: bounds of a map's numeric keys (a value beyond them is a typo, and some would hang a read)
+MAX_HEADER_ROWS = 10_000
+MAX_RUN_ID_PARTS = 10
+MAX_COLUMNS = 1000
+MAX_SCALE = 1e12
+
+
+def _table(path: Path, where: str, value: Any) -> dict:
+    if not isinstance(value, dict):
+        raise _fail(path, where, f"must be a table, not {type(value).__name__}")
+    return value
+
+
+def _text(path: Path, where: str, value: Any, default: str | None = None) -> str | None:
+    if value is None:
+        return default
+    if not isinstance(value, str):
+        raise _fail(path, where, f"must be text, not {type(value).__name__}")
+    return value
+
+
+def _integer(path: Path, where: str, value: Any, default: int, low: int, high: int) -> int:
+    if value is None:
+        return default
+    if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+        raise _fail(path, where, f"must be a whole number from {low} to {high}")
+    return value
+
+
+def _number(path: Path, where: str, value: Any, default: float) -> float:
+    if value is None:
+        return default
+    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+            or not abs(value) <= MAX_SCALE:
+        raise _fail(path, where, f"must be a number of magnitude at most {MAX_SCALE:g}")
+    return float(value)
+
+
+def _file_name(path: Path, where: str, value: Any) -> str | None:
+    """A file name relative to the run's folder, never outside it."""
+    name = _text(path, where, value)
+    if name is not None and (not name or Path(name).is_absolute() or ".." in Path(name).parts
+                             or "\\" in name):
+        raise _fail(path, where, "must name a file inside the run's folder (no absolute path, "
+                    "no '..')")
+    return name
+
+
 def _unit(path: Path, where: str, unit: Any, quantity: str | None) -> str:
     if not isinstance(unit, str) or units.lookup(unit) is None:
         raise _fail(path, where, f"unknown unit {unit!r}; known: {' '.join(units.UNITS)}")
@@ -154,9 +202,10 @@ def _unit(path: Path, where: str, unit: Any, quantity: str | None) -> str:
     return unit.strip()
 
 
-def _channel(path: Path, raw: dict, fmt: str, stream: str) -> ChannelSpec:
+def _channel(path: Path, raw: Any, fmt: str, stream: str) -> ChannelSpec:
+    raw = _table(path, "channels", raw)
     column = raw.get("column")
-    where = str(column)
+    where = str(column)[:60]
     _check_keys(path, where, raw, _CHANNEL_KEYS)
     if not isinstance(column, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", column):
         raise _fail(path, where, "every [[channels]] entry needs column = '<snake_case_name>'")
@@ -164,47 +213,56 @@ def _channel(path: Path, raw: dict, fmt: str, stream: str) -> ChannelSpec:
     if column not in CANONICAL and quantity == "dimensionless":
         raise _fail(path, where, "not a canonical column; an extra column must end in its SI "
                     "unit (" + " ".join(units.SUFFIX_QUANTITY) + ")")
-    if "field" not in raw:
+    if not _text(path, f"{where}.field", raw.get("field")):
         raise _fail(path, where, "missing field = '<source field or column name>'")
-    topic = raw.get("topic", stream if fmt == "delimited" else None)
+    topic = _text(path, f"{where}.topic", raw.get("topic"),
+                  stream if fmt == "delimited" else None)
     if not topic:
         raise _fail(path, where, "missing topic = '<source topic>'")
     zero = raw.get("zero")
     if zero not in (None, "first"):
-        raise _fail(path, where, f"zero = {zero!r}; the only zeroing is 'first'")
-    try:
-        return ChannelSpec(column=column, topic=str(topic), field=str(raw["field"]),
-                           unit=_unit(path, where, raw.get("unit"), quantity),
-                           required=bool(raw.get("required", False)),
-                           csv_file=raw.get("csv_file"), csv_column=raw.get("csv_column"),
-                           scale=float(raw.get("scale", 1.0)), offset=float(raw.get("offset", 0.0)),
-                           zero=zero, zero_value=float(raw.get("zero_value", 0.0)))
-    except (TypeError, ValueError) as exc:
-        raise _fail(path, where, f"bad number: {exc}") from None
+        raise _fail(path, where, f"zero = {str(zero)[:40]!r}; the only zeroing is 'first'")
+    required = raw.get("required", False)
+    if not isinstance(required, bool):
+        raise _fail(path, f"{where}.required", "must be true or false")
+    scale = _number(path, f"{where}.scale", raw.get("scale"), 1.0)
+    if scale == 0:
+        raise _fail(path, f"{where}.scale", "a scale of 0 would erase the channel")
+    return ChannelSpec(column=column, topic=topic, field=raw["field"],
+                       unit=_unit(path, where, raw.get("unit"), quantity), required=required,
+                       csv_file=_file_name(path, f"{where}.csv_file", raw.get("csv_file")),
+                       csv_column=_text(path, f"{where}.csv_column", raw.get("csv_column")),
+                       scale=scale, offset=_number(path, f"{where}.offset", raw.get("offset"), 0.0),
+                       zero=zero,
+                       zero_value=_number(path, f"{where}.zero_value", raw.get("zero_value"), 0.0))
 
 
 def _filename_fields(path: Path, table: dict) -> tuple[str | None, tuple[FilenameField, ...]]:
     if "regex" not in table:
         return None, ()
     _check_keys(path, "metadata.filename", table, {"regex", "fields", "run_id_parts"})
-    regex = table.get("regex")
+    regex = _text(path, "metadata.filename.regex", table.get("regex"))
     try:
         groups = set(re.compile(regex).groupindex)
-    except (re.error, TypeError) as exc:
+    except re.error as exc:
         raise _fail(path, "metadata.filename.regex", f"bad regular expression: {exc}") from None
     out = []
-    for key, spec in table.get("fields", {}).items():
+    for key, spec in _table(path, "metadata.filename.fields", table.get("fields", {})).items():
         where = f"metadata.filename.fields.{key}"
         if "." not in key:
             raise _fail(path, where, "key must be '<record>.<key>', e.g. 'run.velocity_mps'")
+        spec = _table(path, where, spec)
         _check_keys(path, where, spec, {"group", "unit", "omit_if", "also"})
         if spec.get("group") not in groups:
-            raise _fail(path, where, f"group {spec.get('group')!r} is not a named group of regex")
+            raise _fail(path, where, "group is not a named group of regex")
         unit = spec.get("unit")
         if unit is not None:
             _unit(path, where, unit, None)
+        omit_if = spec.get("omit_if")
         out.append(FilenameField(key=key, group=spec["group"], unit=unit,
-                                 omit_if=spec.get("omit_if"), also=dict(spec.get("also", {}))))
+                                 omit_if=None if omit_if is None else _number(
+                                     path, f"{where}.omit_if", omit_if, 0.0),
+                                 also=dict(_table(path, f"{where}.also", spec.get("also", {})))))
     return regex, tuple(out)
 
 
@@ -214,14 +272,17 @@ def _parse(path: Path, text: str) -> ChannelMap:
     except tomllib.TOMLDecodeError as exc:
         raise _fail(path, None, f"not valid TOML: {exc}") from None
     _check_keys(path, "(top level)", doc, _TOP_KEYS)
-    head = doc.get("map", {})
+    head = _table(path, "map", doc.get("map", {}))
     fmt = head.get("format", "spec")
     if fmt not in FORMATS:
-        raise _fail(path, "map.format", f"{fmt!r}; use one of {', '.join(FORMATS)}")
-    files = doc.get("files", {})
+        raise _fail(path, "map.format", f"{str(fmt)[:40]!r}; use one of {', '.join(FORMATS)}")
+    files = _table(path, "files", doc.get("files", {}))
     _check_keys(path, "files", files, _FILES_KEYS)
-    stream = str(files.get("stream", "delimited"))
-    channels = tuple(_channel(path, c, fmt, stream) for c in doc.get("channels", []))
+    stream = _text(path, "files.stream", files.get("stream"), "delimited")
+    listed = doc.get("channels", [])
+    if not isinstance(listed, list):
+        raise _fail(path, "channels", "must be an array of [[channels]] tables")
+    channels = tuple(_channel(path, c, fmt, stream) for c in listed)
     if not channels:
         raise _fail(path, "channels", "no [[channels]] entries")
     seen: set[str] = set()
@@ -229,26 +290,40 @@ def _parse(path: Path, text: str) -> ChannelMap:
         if c.column in seen:
             raise _fail(path, c.column, "fed twice; map each canonical column once")
         seen.add(c.column)
-    time = doc.get("time", {})
+    time = _table(path, "time", doc.get("time", {}))
     _check_keys(path, "time", time, {"column", "unit"})
     time_unit = _unit(path, "time.unit", time.get("unit", "s"), "time")
-    columns = tuple(str(c) for c in files.get("columns", ()))
+    time_column = _text(path, "time.column", time.get("column"), "t_s")
+    columns = files.get("columns", [])
+    if not isinstance(columns, list) or len(columns) > MAX_COLUMNS \
+            or not all(isinstance(c, str) for c in columns):
+        raise _fail(path, "files.columns", f"must be a list of at most {MAX_COLUMNS} names")
+    columns = tuple(columns)
+    pattern = _text(path, "files.pattern", files.get("pattern"))
+    if pattern is not None and ("/" in pattern or "\\" in pattern or ".." in pattern):
+        raise _fail(path, "files.pattern", "must match file names, not paths (no '/', no '..')")
+    delimiter = _text(path, "files.delimiter", files.get("delimiter"), ",")
+    comment = _text(path, "files.comment", files.get("comment"))
+    if not 1 <= len(delimiter) <= 4 or (comment is not None and len(comment) != 1):
+        raise _fail(path, "files", "delimiter must be 1 to 4 characters, comment 1 character")
     if fmt == "delimited":
         if not columns:
             raise _fail(path, "files.columns", "a delimited map needs the column order")
-        for name in [time.get("column", "t_s")] + [c.field for c in channels]:
+        for name in [time_column] + [c.field for c in channels]:
             if name not in columns:
-                raise _fail(path, name, f"not one of files.columns ({', '.join(columns)})")
-    metadata = dict(doc.get("metadata", {}))
-    filename = metadata.pop("filename", {})
+                raise _fail(path, name[:60], f"not one of files.columns ({', '.join(columns)})")
+    metadata = dict(_table(path, "metadata", doc.get("metadata", {})))
+    filename = _table(path, "metadata.filename", metadata.pop("filename", {}))
     regex, fname_fields = _filename_fields(path, filename)
+    defaults = {k: dict(_table(path, f"metadata.{k}", v)) for k, v in metadata.items()}
     return ChannelMap(
-        name=str(head.get("name", path.stem)), path=path, format=fmt, channels=channels,
-        time_column=str(time.get("column", "t_s")), time_unit=time_unit,
-        file_pattern=files.get("pattern"), delimiter=str(files.get("delimiter", ",")),
-        header_rows=int(files.get("header_rows", 0)), columns=columns,
-        comment=files.get("comment"), stream=stream,
-        metadata_defaults={k: dict(v) for k, v in metadata.items()},
+        name=_text(path, "map.name", head.get("name"), path.stem), path=path, format=fmt,
+        channels=channels, time_column=time_column, time_unit=time_unit,
+        file_pattern=pattern, delimiter=delimiter,
+        header_rows=_integer(path, "files.header_rows", files.get("header_rows"), 0, 0,
+                             MAX_HEADER_ROWS),
+        columns=columns, comment=comment, stream=stream, metadata_defaults=defaults,
         filename_regex=regex, filename_fields=fname_fields,
-        run_id_parts=int(filename.get("run_id_parts", 1)),
-        description=str(head.get("description", "")))
+        run_id_parts=_integer(path, "metadata.filename.run_id_parts",
+                              filename.get("run_id_parts"), 1, 1, MAX_RUN_ID_PARTS),
+        description=_text(path, "map.description", head.get("description"), ""))

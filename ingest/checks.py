@@ -9,6 +9,8 @@ import pandas as pd
 
 from ingest.errors import IngestError
 from ingest.raw import RawTopic
+from ingest.units import column_quantity
+from swtlab.domain.ranges import CHANNEL_LIMITS, COLUMN_LIMITS
 
 
 def check_topic(path: Path, topic: str, raw: RawTopic) -> None:
@@ -40,13 +42,47 @@ def check_topic(path: Path, topic: str, raw: RawTopic) -> None:
                               f"at t={t[first]:.6f} s; fix or drop them at the source")
 
 
+#: longest text of a bad cell an error line quotes
+MAX_CELL_CHARS = 40
+
+
+def _float_or_nan(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        return float("nan")
+
+
 def numeric_column(path: Path, frame: pd.DataFrame, column: str, first_row: int) -> np.ndarray:
     """A text-table column as float64; a non-numeric cell is an IngestError naming the first
     one (``first_row``: the file's line number of the frame's first data row)."""
-    values = pd.to_numeric(frame[column], errors="coerce").to_numpy(np.float64)
+    try:
+        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(np.float64)
+    except OverflowError:  # an integer cell beyond float64: inf, which check_topic reports
+        values = pd.to_numeric(frame[column].astype(str).map(_float_or_nan),
+                               errors="coerce").to_numpy(np.float64)
     bad = np.isnan(values) & frame[column].notna().to_numpy()
     if bad.any():
         row = int(np.argmax(bad))
+        cell = repr(frame[column].iloc[row])
+        cell = cell if len(cell) <= MAX_CELL_CHARS else cell[:MAX_CELL_CHARS - 3] + "..."
         raise IngestError(path, column, f"{int(bad.sum())} non-numeric values, first in line "
-                          f"{row + first_row}: {frame[column].iloc[row]!r}")
+                          f"{row + first_row}: {cell}")
     return values
+
+
+def check_calibrated(path: Path, where: str, column: str, values: np.ndarray) -> None:
+    """A channel after calibration and zeroing: every sample finite and within the
+    magnitude its quantity (or column) can have on a testbed (``swtlab.domain.ranges``);
+    beyond it the gain, offset, zero or unit is wrong."""
+    bad = ~np.isfinite(values)
+    if bad.any():
+        raise IngestError(path, where, f"{int(bad.sum())} samples of {column} are NaN/inf after "
+                          "calibration and zeroing (gain, offset or zero overflows)")
+    quantity = column_quantity(column)
+    limit = COLUMN_LIMITS.get(column, CHANNEL_LIMITS[quantity])
+    peak = float(np.max(np.abs(values))) if values.size else 0.0
+    if peak > limit:
+        raise IngestError(path, where, f"{column} reaches {peak:.3g} (SI) after calibration "
+                          f"and zeroing, beyond any {quantity} a testbed measures ({limit:g}); "
+                          "check gain, offset, zero and unit")

@@ -25,14 +25,18 @@ def read_csv_run(folder: Path, cmap: ChannelMap) -> RawRun:
         records = json.loads(meta_path.read_text(encoding="utf-8"))
     except OSError as exc:
         raise IngestError(meta_path, None, f"cannot read: {exc.strerror}") from None
-    except ValueError as exc:
-        raise IngestError(meta_path, None, f"not valid JSON: {exc}") from None
+    except (ValueError, RecursionError) as exc:
+        why = "nested too deeply" if isinstance(exc, RecursionError) else exc
+        raise IngestError(meta_path, None, f"not valid JSON: {why}") from None
     if not isinstance(records, dict) or not all(isinstance(v, dict) for v in records.values()):
         raise IngestError(meta_path, None, 'expected {"run": {...}, "wheel": {...}, ...}')
     topics = {}
     for topic in cmap.topics:
         specs = cmap.channels_of(topic)
         csv_path = folder / specs[0].csv_name
+        if not csv_path.resolve().is_relative_to(folder.resolve()):
+            raise IngestError(folder, topic, f"channel map {cmap.name}: {specs[0].csv_name} "
+                              "lies outside the run's folder; a map may only name files in it")
         if csv_path.is_file():
             topics[topic] = _read_topic(csv_path, cmap, {c.csv_column or c.field: c.field
                                                          for c in specs})

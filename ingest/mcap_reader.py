@@ -69,7 +69,10 @@ def _loads(message: bytes):
     try:
         return orjson.loads(message)
     except orjson.JSONDecodeError:
-        return json.loads(message)
+        try:
+            return json.loads(message)
+        except RecursionError:
+            raise ValueError("nested too deeply") from None
 
 
 def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
@@ -97,30 +100,48 @@ def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
                               f"({', '.join(f'{k} {n}' for k, n in sizes.items())}); "
                               "every field of a block must have one value per t_ns")
         lengths[i] = sizes["t_ns"]
+    total = int(lengths.sum())
+    t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64)  # checked before sorting
     firsts = np.array([b["t_ns"][0] if b["t_ns"] else np.iinfo(np.int64).max for b in blocks])
     blocks = [blocks[i] for i in np.argsort(firsts, kind="stable")]
-    total = int(lengths.sum())
     t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64)
     fields = {k: _flatten(path, topic, k, blocks, total, np.float64) for k in names if k != "t_ns"}
     return RawTopic(t_s=t_ns * 1e-9, fields=fields)
 
 
+#: JSON types a sample may have: numbers, and null (how many writers spell NaN)
+_SAMPLE_TYPES = {int, float, type(None)}
+#: time stamps: whole nanoseconds from the run start, at most this many (a century)
+MAX_T_NS = 100 * 365 * 86400 * 10**9
+
+
 def _flatten(path: Path, topic: str, name: str, blocks: list[dict], total: int,
              dtype: type) -> np.ndarray:
-    values = chain.from_iterable(b[name] for b in blocks)
-    try:
-        return np.fromiter(values, dtype=dtype, count=total)
-    except (TypeError, ValueError):
-        pass
-    try:  # JSON null (how many writers spell NaN) becomes NaN and is reported by the checks
-        out = np.array(list(chain.from_iterable(b[name] for b in blocks)), dtype=np.float64)
-    except (TypeError, ValueError):
-        raise IngestError(path, f"{topic}.{name}", "non-numeric values in the samples") from None
+    """One field of every block as one array. A sample that is not a JSON number or null
+    (true/false, a numeric string, a list) is an error, not converted; a time stamp must be a
+    whole number of ns in ``0..MAX_T_NS``; a number beyond float64 is an error."""
+    where = f"{topic}.{name}"
+    kinds = set(map(type, chain.from_iterable(b[name] for b in blocks)))
+    if not kinds <= _SAMPLE_TYPES:
+        bad = sorted(k.__name__ for k in kinds - _SAMPLE_TYPES)
+        raise IngestError(path, where, f"samples of JSON type {', '.join(bad)}; every sample "
+                          "must be a number (or null)")
     if dtype is np.int64:
-        if not np.isfinite(out).all():
-            raise IngestError(path, f"{topic}.t_ns", "missing (null) time stamps")
-        return out.astype(np.int64)
-    return out
+        if kinds - {int}:
+            raise IngestError(path, where, "time stamps must be whole numbers of ns (no "
+                              "decimals, no null)")
+        values = list(chain.from_iterable(b[name] for b in blocks))
+        if values and not (0 <= min(values) and max(values) <= MAX_T_NS):
+            raise IngestError(path, where, f"time stamps outside 0..{MAX_T_NS} ns (t_ns counts "
+                              "ns from the run start)")
+        return np.array(values, dtype=np.int64)
+    values = chain.from_iterable(b[name] for b in blocks)
+    if type(None) in kinds:
+        values = (np.nan if v is None else v for v in values)
+    try:
+        return np.fromiter(values, dtype=np.float64, count=total)
+    except OverflowError:
+        raise IngestError(path, where, "a sample is beyond the float64 range") from None
 
 
 def _frame_index(path: Path, topic: str, data: list[bytes]) -> FrameIndex:

@@ -14,6 +14,10 @@ from typing import Any, Callable, Mapping
 
 from ingest.errors import IngestError, Problem
 from swtlab.domain import G0_MPS2, MODES, Wheel
+from swtlab.domain.ranges import METADATA
+
+#: longest text of a bad value an error message quotes
+MAX_SHOWN_CHARS = 40
 WRENCH_FIELDS = ("fx", "fy", "fz", "tx", "ty", "tz")
 RECORDS = ("run", "wheel", "suspension", "camera", "camera_track", "zero", "calibration")
 
@@ -104,6 +108,12 @@ class RunMetadata:
         return out
 
 
+def _shown(value: Any) -> str:
+    """``repr`` of a bad value for an error line, cut to :data:`MAX_SHOWN_CHARS`."""
+    text = repr(value) if not isinstance(value, int) or abs(value) < 10**30 else "a huge integer"
+    return text if len(text) <= MAX_SHOWN_CHARS else text[:MAX_SHOWN_CHARS - 3] + "..."
+
+
 class _Reader:
     """Typed access to one record; every failure is an IngestError naming record.key."""
 
@@ -119,10 +129,12 @@ class _Reader:
             if required:
                 raise self.fail(key, f"missing; add it to the swt.{self.name} metadata record")
             return None
+        if isinstance(value, (bool, list, dict)):
+            raise self.fail(key, f"{_shown(value)} is not {kind}")
         try:
             return conv(value)
-        except (TypeError, ValueError):
-            raise self.fail(key, f"{value!r} is not {kind}") from None
+        except (TypeError, ValueError, OverflowError):
+            raise self.fail(key, f"{_shown(value)} is not {kind}") from None
 
     def text(self, key: str, required: bool = True) -> str | None:
         return self._get(key, required, lambda v: str(v).strip(), "text")
@@ -130,7 +142,7 @@ class _Reader:
     def number(self, key: str, required: bool = True) -> float | None:
         value = self._get(key, required, float, "a number")
         if value is not None and not math.isfinite(value):
-            raise self.fail(key, f"{value!r} is not a finite number")
+            raise self.fail(key, f"{_shown(value)} is not a finite number")
         return value
 
     def integer(self, key: str, required: bool = True) -> int | None:
@@ -306,4 +318,31 @@ def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
         camera_track=camera_track,
         zero=_zero(path, records.get("zero", {})),
         calibration=calibration, calibration_u=calibration_u)
+    _check_ranges(path, metadata)
     return metadata, problems
+
+
+def _check_ranges(path: Path, metadata: RunMetadata) -> None:
+    """Every number of the typed metadata within its possible range (``swtlab.domain.ranges``;
+    outside it no testbed could have measured the run)."""
+    values = {f"{record}.{key}": value for record in ("run", "wheel", "suspension", "camera",
+                                                      "camera_track")
+              for key, value in _fields(getattr(metadata, record)).items()}
+    values.update({f"zero.{k}": v for k, v in metadata.zero.items()})
+    for name, value in values.items():
+        limits = METADATA.get(name, METADATA.get(name.partition(".")[0]))
+        if limits is None or value is None or isinstance(value, (str, bool, tuple, datetime)):
+            continue
+        why = limits.impossible(float(value))
+        if why:
+            raise IngestError(path, f"swt.{name}", why)
+
+
+#: typed field names that differ from the metadata keys
+_KEY_OF = {"load_n": "load_N", "stiffness_n_per_mm": "stiffness_N_per_mm"}
+
+
+def _fields(part: Any) -> dict[str, Any]:
+    if part is None:
+        return {}
+    return {_KEY_OF.get(k, k): v for k, v in vars(part).items()}

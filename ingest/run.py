@@ -12,7 +12,7 @@ from ingest import derive
 from ingest.calibration import subtract_zero, to_canonical
 from ingest.canonical import CANONICAL, DERIVED, MEASURED, SUBSTITUTES, WRENCH_COLUMNS
 from ingest.channel_map import ChannelMap, load_channel_map
-from ingest.checks import check_topic
+from ingest.checks import check_calibrated, check_topic
 from ingest.csv_reader import read_csv_run
 from ingest.delimited_reader import read_delimited
 from ingest.errors import IngestError, Problem
@@ -21,11 +21,13 @@ from ingest.metadata import RunMetadata, parse_metadata
 from ingest.raw import FrameIndex, RawRun
 from ingest.records import merged_records
 from ingest.timebase import (DROP_FACTOR, GAP_FACTOR, JITTER_LIMIT, StreamTiming, common_grid,
-                             grid_mask, stream_timing, to_grid)
+                             grid_mask, grid_size, stream_timing, to_grid)
 
 _ZERO_OF = {column: fld for fld, column in WRENCH_COLUMNS.items()}
 #: longest plausible run; longer spans mean a stream is on another clock
 MAX_RUN_S = 6 * 3600.0
+#: a time base longer than this many times the longest stream is a stray time stamp
+MAX_GRID_PER_SAMPLE = 20
 
 
 @dataclass(frozen=True)
@@ -133,9 +135,11 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
                 continue
             cal = metadata.calibration.get((topic, spec.field))
             used.add((topic, spec.field))
-            values = to_canonical(data.fields[spec.field], spec, cal)
-            if spec.column in _ZERO_OF:
-                values = subtract_zero(values, metadata.zero.get(_ZERO_OF[spec.column]))
+            with np.errstate(over="ignore", invalid="ignore"):
+                values = to_canonical(data.fields[spec.field], spec, cal)
+                if spec.column in _ZERO_OF:
+                    values = subtract_zero(values, metadata.zero.get(_ZERO_OF[spec.column]))
+            check_calibrated(raw.path, f"{topic}.{spec.field}", spec.column, values)
             columns[spec.column] = values
             units[spec.column] = spec.unit if cal is None else "SI (swt.calibration)"
         streams[topic] = pd.DataFrame(columns)
@@ -153,6 +157,12 @@ def _check_clocks(path: Path, timing: dict[str, StreamTiming]) -> None:
             raise IngestError(path, topic, f"time stamps reach {s.t1_s - start:.6g} s after the "
                               f"run start (over {MAX_RUN_S / 3600:g} h): t_ns must count from "
                               "the run start; is this stream on another clock?")
+    grid, _ = grid_size(list(timing.values()))
+    recorded = max(s.n for s in timing.values())
+    if grid > MAX_GRID_PER_SAMPLE * max(recorded, 1):
+        raise IngestError(path, None, f"the streams span {grid} samples of the time base but "
+                          f"the longest holds {recorded}: a time stamp far from the others? "
+                          "(t_ns must count from the run start)")
 
 
 def _timing_problems(timing: dict[str, StreamTiming]) -> list[Problem]:

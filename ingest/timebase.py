@@ -59,14 +59,20 @@ def stream_timing(t_s: np.ndarray) -> StreamTiming:
         jitter=float(np.std(regular) / median) if len(regular) else 0.0)
 
 
-def common_grid(timings: list[StreamTiming]) -> tuple[np.ndarray, float]:
-    """Uniform time base over the union of the streams' spans; rate = fastest median, capped."""
+def grid_size(timings: list[StreamTiming]) -> tuple[int, float]:
+    """Samples and rate of the uniform time base: the union of the streams' spans at the
+    fastest median rate, capped at ``MAX_RATE_HZ``."""
     rates = [s.rate_hz for s in timings if np.isfinite(s.rate_hz)]
     rate = min(max(rates), MAX_RATE_HZ) if rates else 1.0
     t0 = min(s.t0_s for s in timings)
     t1 = max(s.t1_s for s in timings)
-    n = int(np.floor((t1 - t0) * rate + 1e-9)) + 1
-    return t0 + np.arange(n) / rate, rate
+    return int(np.floor((t1 - t0) * rate + 1e-9)) + 1, rate
+
+
+def common_grid(timings: list[StreamTiming]) -> tuple[np.ndarray, float]:
+    """Uniform time base (:func:`grid_size`) from the earliest time stamp."""
+    n, rate = grid_size(timings)
+    return min(s.t0_s for s in timings) + np.arange(n) / rate, rate
 
 
 def grid_mask(t_s: np.ndarray, timing: StreamTiming, grid: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 
 from run_results.result import RunResult
-from swtlab.domain.results import COLUMNS, WHEEL_COLUMNS, check_results
+from swtlab.domain.results import COLUMNS, WHEEL_COLUMNS, budget_columns, check_results
 
 
 GROUP = ["wheel", "soil", "multipass", "load_set_n"]
@@ -30,6 +30,8 @@ def results_row(r: RunResult) -> dict:
            "window_end_s": w.end_s, "window_method": w.method, "no_window_reason": w.reason}
     for name, q in r.quantities.items():
         row.update({f"{name}_mean": q.mean, f"{name}_std": q.std, f"{name}_se": q.se})
+        if name in r.uncertainty:
+            row.update(budget_columns(name, r.uncertainty[name].to_dict()))
     row.update(r.oscillation)
     return row
 

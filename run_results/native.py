@@ -37,7 +37,7 @@ SINGLE_CHANNEL = {"wheel_load_n": ("fz_n", False), "dp_n": ("dp_n", False),
                   "side_force_n": ("fy_n", False)}
 
 
-def _samples(run, column: str, start_s: float, end_s: float):
+def channel_samples(run, column: str, start_s: float, end_s: float):
     for frame in run.streams.values():
         if column in frame.columns:
             t = frame["t_s"].to_numpy()
@@ -46,10 +46,10 @@ def _samples(run, column: str, start_s: float, end_s: float):
     return None
 
 
-def _hub_samples(run, start_s: float, end_s: float):
+def hub_samples(run, start_s: float, end_s: float):
     """A logged hub height, or the arm angle through ``L (sin(angle) - sin(angle_zero))``."""
-    direct = _samples(run, "hub_height_m", start_s, end_s)
-    angle = _samples(run, "suspension_angle_rad", start_s, end_s)
+    direct = channel_samples(run, "hub_height_m", start_s, end_s)
+    angle = channel_samples(run, "suspension_angle_rad", start_s, end_s)
     if direct is not None or angle is None or run.metadata.suspension is None:
         return direct
     s = run.metadata.suspension
@@ -77,13 +77,13 @@ def native_quantities(run, start_s: float, end_s: float, units: dict[str, str],
     radius = run.metadata.wheel.radius_m
     stats = {}
     for key, (column, per_radius) in SINGLE_CHANNEL.items():
-        samples = _samples(run, column, start_s, end_s)
+        samples = channel_samples(run, column, start_s, end_s)
         if key in units and samples is not None:
             t, y = samples
             result = native_stats(t, y / radius if per_radius else y, frequency_hz, units[key])
             if result is not None:
                 stats[key] = result
-    hub = _hub_samples(run, start_s, end_s)
+    hub = hub_samples(run, start_s, end_s)
     if hub is not None and (rig is None or rig.kind == "linear"):
         result = native_stats(*hub, frequency_hz, units["hub_height_m"])
         if result is not None:

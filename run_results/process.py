@@ -5,13 +5,15 @@ slip, travel velocity, wheel angular velocity, wheel load ``fz``, drawbar pull, 
 torque ``ty``, thrust ``H = T/r``, motion resistance ``R = T/r - DP`` (Wong, Theory of
 Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correction; for
 steered runs also the side force ``fy`` and the slip angle (logged channel, else the
-set steering angle). Single-channel quantities come from the native samples, the means of
-resistance and sinkage from the channels' native means (``native``). Given the run's track
-photos as measured (``image_slip``: the slip read from the grouser marks by
-``softflow.track_run``, which the pipeline calls; this module opens no photo), the result
-also reports ``image_slip`` beside the encoder slip. Every result carries its channels'
-decimated traces of DP, torque, sinkage and slip (``run_results.traces``), so plots need not
-read the raw file again.
+set steering angle). Plausibility and sensor health (``plausibility``: saturation, dead
+channels, SE of 0, negative load or sinkage, set against measured load, metadata ranges,
+dig-in) are checked on the calibrated, zeroed channels and flag the run. Single-channel
+quantities come from the native samples, the means of resistance and sinkage from the
+channels' native means (``native``). Given the run's track photos as measured
+(``image_slip``: the slip read from the grouser marks by ``softflow.track_run``, which the
+pipeline calls; this module opens no photo), the result also reports ``image_slip`` beside
+the encoder slip. Every result carries its channels' decimated traces of DP, torque,
+sinkage and slip (``run_results.traces``), so plots need not read the raw file again.
 """
 
 from __future__ import annotations
@@ -24,9 +26,12 @@ from run_results import oscillation as osc
 from run_results.corrections import RigCompliance, corrected_heights, tare_record
 from run_results.native import native_quantities
 from run_results.phase_average import phase_average
+from run_results.plausibility import plausibility_flags
+from run_results.rest_readings import rest_readings
 from run_results.result import RunResult
-from run_results.stats import QuantityStats, quantity_stats
+from run_results.stats import QuantityStats, batch_means_se, quantity_stats
 from run_results.traces import run_traces
+from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
 from swtlab.domain.results import wheel_columns
@@ -81,17 +86,18 @@ def _series(run, rig: RigCompliance | None) -> tuple[dict[str, tuple[np.ndarray,
 def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
     """Passing frequency measured in the forces against ``n omega/2pi``; waveform peaks."""
     n = run.metadata.wheel.grouser_count
-    omega = float(np.nanmean(series["wheel_omega_radps"][0][lo:hi]))
-    out = {"grouser_expected_hz": n * abs(omega) / (2.0 * np.pi) if n > 0 else None,
+    omega = series["wheel_omega_radps"][0][lo:hi]
+    expected = n * abs(float(np.nanmean(omega))) / (2.0 * np.pi) if np.isfinite(omega).any() else 0
+    out = {"grouser_expected_hz": _frequency(expected) if n > 0 else None,
            "grouser_measured_hz": None, "grouser_signal": None}
     candidates = [k for k in ("dp_n", "torque_nm", "wheel_load_n")
                   if np.isfinite(series[k][0][lo:hi]).mean() > 0.5
                   and not (k == "dp_n" and run.metadata.run.mode == "free_sled")]
-    if n > 0 and candidates:
+    if out["grouser_expected_hz"] and candidates:
         signal = candidates[0]
         out["grouser_signal"] = signal
-        out["grouser_measured_hz"] = osc.measure_frequency_hz(
-            t[lo:hi], series[signal][0][lo:hi], out["grouser_expected_hz"])
+        out["grouser_measured_hz"] = _frequency(osc.measure_frequency_hz(
+            t[lo:hi], series[signal][0][lo:hi], out["grouser_expected_hz"]))
     frequency = out["grouser_measured_hz"] or out["grouser_expected_hz"]
     for key, name, unit in (("dp_n", "dp", "n"), ("torque_nm", "torque", "nm")):
         y = series[key][0][lo:hi]
@@ -105,6 +111,12 @@ def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
                      "grid over +-40 % of n*omega/2pi refined by Brent; peaks from the "
                      "phase-averaged waveform")
     return out, frequency
+
+
+def _frequency(hz: float) -> float | None:
+    """A passing frequency that can be used (finite, > 0), else None (a wheel that does not
+    turn has none)."""
+    return float(hz) if np.isfinite(hz) and hz > 0 else None
 
 
 def _flags(run, window, oscillation: dict) -> list[str]:
@@ -138,10 +150,13 @@ def _image_slip(image) -> tuple[dict[str, QuantityStats], list[str]]:
 
 
 def process_run(run, params: StablePhaseParams | None = None,
-                rig: RigCompliance | None = None, image_slip=None) -> RunResult:
+                rig: RigCompliance | None = None, image_slip=None,
+                budget: BudgetParams | None = None) -> RunResult:
     """Stable window, corrected quantities with honest SE, oscillation and flags of one run;
     ``image_slip``, the run's track photos as measured (``softflow.track_run.run_image_slip``,
-    which the pipeline calls), is reported beside the encoder slip."""
+    which the pipeline calls), is reported beside the encoder slip. Every quantity has an
+    uncertainty budget (``run_results.uncertainty_budget``, told the rig's clock by
+    ``budget``); its mean carries the budget's re-zeroing on the rest readings."""
     window = detect_stable_phase(run, params)
     image_quantities, image_flags = _image_slip(image_slip)
     series, applied = _series(run, rig)
@@ -169,6 +184,13 @@ def process_run(run, params: StablePhaseParams | None = None,
         stats = quantity_stats(y[lo:hi], unit, average)
         if stats is not None:
             quantities[key] = stats
+    rate_batches = {}
+    for key in RATES:
+        if key in quantities:
+            y = series[key][0][lo:hi]
+            periodic = (phase_average(t[lo:hi], y, frequency)["periodic"]
+                        if frequency and np.isfinite(y).sum() > 16 else None)
+            rate_batches[key] = batch_means_se(y, periodic)
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     quantities.update({k: v for k, v in native.items() if k in quantities})
@@ -176,6 +198,12 @@ def process_run(run, params: StablePhaseParams | None = None,
                        if k in quantities})
     corrections["hub_height_correction_mean_m"] = float(np.nanmean(applied["correction_m"][lo:hi]))
     quantities.update(image_quantities)
-    flags = (*_flags(run, window, oscillation), *image_flags)
+    rests = rest_readings(run)
+    corrections["rest_readings"] = None if rests is None else rests.to_dict()
+    quantities, budgets = run_budget(run, (window.start_s, window.end_s), quantities, rests,
+                                     budget, rate_batches, frequency)
+    flags = (*_flags(run, window, oscillation), *image_flags,
+             *plausibility_flags(run, window, quantities, params or StablePhaseParams()))
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,
-                     oscillation=oscillation, dp_trace=None, corrections=corrections, **common)
+                     oscillation=oscillation, dp_trace=None, corrections=corrections,
+                     uncertainty=budgets, **common)

@@ -29,6 +29,8 @@ class RunResult:
     corrections: dict
     condition: dict = field(default_factory=dict)
     traces: dict[str, Trace] = field(default_factory=dict)
+    #: quantity -> ``run_results.uncertainty_budget.QuantityBudget``
+    uncertainty: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
@@ -41,4 +43,5 @@ class RunResult:
             "flags": list(self.flags), "window": self.window.to_dict(),
             "quantities": {k: v.to_dict() for k, v in self.quantities.items()},
             "oscillation": dict(self.oscillation), "dp_trace": self.dp_trace,
-            "corrections": dict(self.corrections), "condition": dict(self.condition)})
+            "corrections": dict(self.corrections), "condition": dict(self.condition),
+            "uncertainty": {k: b.to_dict() for k, b in self.uncertainty.items()}})

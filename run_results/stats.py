@@ -62,3 +62,32 @@ def quantity_stats(y, unit: str, average: dict | None = None) -> QuantityStats |
     se = float(np.sqrt(g * np.sum(resid**2) / dof * var_factor))
     return QuantityStats(mean=average["mean"], std=std, se=se, n=n,
                          n_eff=float(1.0 / (g * var_factor)), unit=unit)
+
+
+
+#: batches of :func:`batch_means_se`
+BATCHES = 20
+
+
+def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, float] | None:
+    """``(se, dof)`` of the window mean from non-overlapping batch means (Schmeiser 1982,
+    Operations Research 30(3) 556) with their lag-1 autocovariance (a Newey-West estimate on
+    the batch means, Newey & West 1987, Econometrica 55(3) 703, one lag at full weight):
+    ``se^2 = (c0 + 2 c1) / B`` on ``B - 2`` degrees of freedom, on ``y`` less its ``periodic``
+    part (the phase-averaged grouser wave) where given. The lag-1 term takes out what one
+    batch's end shares with the next: the telescoping noise of a rate derived from noisy
+    positions (which plain batch means overstate ``sqrt(B)`` times) and a correlation
+    spilling over one batch; so it sees a drive's slow ripple that ends a summed
+    autocorrelation early. None with fewer than 4 finite samples per batch or a negative
+    estimate."""
+    y = np.asarray(y, float)
+    if periodic is not None:
+        y = y - np.nan_to_num(np.asarray(periodic, float))
+    y = y[np.isfinite(y)]
+    size = y.size // batches
+    if size < 4:
+        return None
+    means = y[: size * batches].reshape(batches, size).mean(axis=1)
+    d = means - means.mean()
+    var = (float(d @ d) + 2.0 * float(d[1:] @ d[:-1])) / (batches - 1) / batches
+    return (float(np.sqrt(var)), float(batches - 2)) if var > 0 else None

@@ -35,8 +35,9 @@ Z_TIE = 2.0
 MIN_LOG_EXCESS = 0.02
 Z_CONFIDENT = 4.0
 MIN_GAIN = 0.25
-#: a held-out RMS of 2 sigma: with honest sigmas a right model leaves about 1 sigma
-UNEXPLAINED_LOSS = 4.0
+#: a held-out RMS of sqrt(2) sigma: with honest sigmas a right model leaves about 1 sigma
+#: (the mean of ~100 squared residuals exceeds 2 with a chance below 1e-6)
+UNEXPLAINED_LOSS = 2.0
 
 
 def paired_z(worse: np.ndarray, better: np.ndarray) -> float:

@@ -111,7 +111,7 @@ def from_database(url: str) -> pd.DataFrame:
     from traceability import open_database
     from traceability.queries import latest_results
 
-    with open_database(url)() as session:
+    with open_database(url, read_only=True)() as session:
         return from_results_table(latest_results(session), source=url)
 
 
@@ -171,10 +171,25 @@ def from_cmu_smooth_runs(path: str | Path) -> pd.DataFrame:
     return _finish(table, str(path), wheel, sinkage_relative=True)
 
 
-def load_measured(source: str) -> pd.DataFrame:
-    """A database URL (``scheme://...``), a WPM CSV, a points CSV or a CMU
-    ``smooth_runs.csv``."""
+#: the first bytes of every SQLite database file
+SQLITE_MAGIC = b"SQLite format 3\x00"
+
+
+def is_database(source: str) -> bool:
+    """Whether ``source`` names a database: a URL (``scheme://...``) or a SQLite file."""
     if "://" in source:
+        return True
+    try:
+        with open(source, "rb") as stream:
+            return stream.read(len(SQLITE_MAGIC)) == SQLITE_MAGIC
+    except OSError:
+        return False
+
+
+def load_measured(source: str) -> pd.DataFrame:
+    """A database URL (``scheme://...``) or SQLite file, a WPM CSV, a points CSV or a CMU
+    ``smooth_runs.csv``."""
+    if is_database(source):
         return from_database(source)
     path = Path(source)
     if not path.exists():

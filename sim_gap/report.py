@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from plain_json import jsonable
+from swtlab.atomic import write_atomically
 
 SCHEMA = "swtlab.gap-report/1"
 
@@ -44,4 +45,4 @@ def build_report(diagnosis: dict, measured_source: str, sim_source: str,
 
 
 def write_json(report: dict, path: str | Path) -> None:
-    Path(path).write_text(json.dumps(report, indent=1, allow_nan=False) + "\n")
+    write_atomically(path, json.dumps(report, indent=1, allow_nan=False) + "\n")

@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from softflow.field_analysis import FlowResult  # noqa: E402
+from swtlab.atomic import atomic_file  # noqa: E402
 
 
 def magnitude_map(result: FlowResult, frame: np.ndarray):
@@ -88,7 +89,8 @@ def write_plots(result: FlowResult, frame: np.ndarray, folder: str | Path) -> li
     for name, fig in (("flow_magnitude.png", magnitude_map(result, frame)),
                       ("flow_profiles.png", profiles_with_fits(result)),
                       ("flow_rates.png", rates_by_beta(result))):
-        fig.savefig(folder / name, dpi=110)
+        with atomic_file(folder / name, "wb") as stream:
+            fig.savefig(stream, format="png", dpi=110)
         plt.close(fig)
         out.append(folder / name)
     return out

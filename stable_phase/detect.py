@@ -28,6 +28,8 @@ from stable_phase.window import StableWindow
 SETTLING = ("hub_height_m", "sinkage_m", "dp_n", "ty_nm")
 CHECKED = ("sinkage_m", "dp_n", "ty_nm")
 MIN_FINITE_FRACTION = 0.5
+#: fewer samples on the time base than this cannot hold a stable phase (nor a rate)
+MIN_SAMPLES = 16
 
 
 def _signals(run, lo: int, hi: int) -> dict[str, np.ndarray]:
@@ -110,12 +112,15 @@ def detect_stable_phase(run, params: StablePhaseParams | None = None) -> StableW
     method = (f"speed-gate + {detector.description} + whole grouser periods "
               "+ slope-test/R-statistic check")
     t = run.channels["t_s"].to_numpy()
-    gate = speed_gate(run, params)
-    diag = dict(gate.diagnostics)
+    diag: dict = {}
 
     def not_found(reason: str) -> StableWindow:
         return StableWindow(False, None, None, method, params.to_dict(), diag, reason)
 
+    if t.size < MIN_SAMPLES:
+        return not_found(f"only {t.size} samples on the time base (needs {MIN_SAMPLES})")
+    gate = speed_gate(run, params)
+    diag.update(gate.diagnostics)
     if gate.start is None:
         return not_found("wheel and sled speeds never hold their set points together")
     ramp, lo, hi = gate.ramp_start, gate.start, gate.stop

@@ -2,7 +2,8 @@
 
 Fits every quantity of every (wheel, soil, multipass, load) group from the newest
 results (docs/fitting.md), stores the fits linked to their run results, writes the
-WPM CSV (docs/wpm-csv.md) and records the export with its sha256 and its fits.
+WPM CSV (docs/wpm-csv.md) and, once the file is in place, records the export with its sha256
+and its fits.
 """
 
 from __future__ import annotations
@@ -42,22 +43,33 @@ def run(args: argparse.Namespace) -> int:
     from fitting import FittingError
     from swtlab.pipeline.curves import export_wpm, fit_curves
     from traceability import open_database
+    from traceability.database import in_transaction
     from traceability.queries import latest_results
     from traceability.store_fits import store_export, store_fits
     from wpm_export.schema import FORMAT
 
     statuses = ("ok", "flagged") if args.include_flagged else ("ok",)
-    session_factory = open_database(args.db)
-    with session_factory.begin() as session:
-        try:
-            curves = fit_curves(latest_results(session), degree=args.degree, statuses=statuses)
-        except (FittingError, ValueError) as error:
-            print(f"swtlab export: {args.db}: {error}", file=sys.stderr)
-            return exit_codes.BAD_INPUT
+    session_factory = open_database(args.db, create=False)
+    with session_factory() as session:
+        table = latest_results(session)
+    try:
+        curves = fit_curves(table, degree=args.degree, statuses=statuses)
+    except (FittingError, ValueError) as error:
+        print(f"swtlab export: {args.db}: {error}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    try:
+        file_hash = export_wpm(curves, args.output)  # renamed into place before it is recorded
+    except OSError as error:
+        print(f"swtlab export: cannot write {args.output}: {error.strerror or error}",
+              file=sys.stderr)
+        return exit_codes.BAD_INPUT
+
+    def record(session) -> None:
         stored = store_fits(session, curves.table, curves.fits, curves.options)
-        file_hash = export_wpm(curves, args.output)
         store_export(session, args.output, file_hash, curves.inputs_sha256, FORMAT, stored,
                      curves.options)
+
+    in_transaction(session_factory, record)
     for error in curves.not_fitted:
         print(f"  not fitted: {error}")
     print(f"{len(curves.fits)} curves from {len(curves.table)} runs written to {args.output} "

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 
 from swtlab_cli import exit_codes
+from swtlab.atomic import write_atomically
 
 ENGINE_CHOICES = ("deform-lk", "farneback", "dis")  # softflow.flow_engine.ENGINES, kept light
 
@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json == "-":
         print(json.dumps(data, indent=2))
     elif args.json:
-        Path(args.json).write_text(json.dumps(data, indent=2))
+        write_atomically(args.json, json.dumps(data, indent=2))
     if args.plots:
         from softflow.flow_plots import write_plots
 

@@ -20,7 +20,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "With a database as the measured side, the report is also recorded there "
                     "(and shown by swtlab report).")
     p.add_argument("--measured", required=True, action="append",
-                   help="database URL (swtlab process), WPM CSV, points CSV "
+                   help="database URL or SQLite file (swtlab process), WPM CSV, points CSV "
                         "(docs/points-csv.md) or CMU smooth_runs.csv; repeat for several "
                         "sources on one soil (fitted jointly, each with its own wheel)")
     p.add_argument("--sim", required=True, help="model TOML or a simulator's WPM CSV")
@@ -86,11 +86,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     report = gap.to_dict()
-    if len(args.measured) == 1 and "://" in args.measured[0]:  # recorded in the database too
+    from sim_gap.measured import is_database
+
+    if len(args.measured) == 1 and is_database(args.measured[0]):  # recorded there too
         from traceability import open_database
         from traceability.store_gap import store_gap_report
 
-        with open_database(args.measured[0]).begin() as session:
+        with open_database(args.measured[0], create=False).begin() as session:
             store_gap_report(session, report)
     for line in report["wheel"]["mismatches"]:
         print(f"wheel mismatch allowed: {line}")

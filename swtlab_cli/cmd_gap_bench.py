@@ -8,6 +8,7 @@ import tempfile
 from pathlib import Path
 
 from swtlab_cli import exit_codes
+from swtlab.atomic import write_atomically
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -57,5 +58,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"time: generate {t['generate']:.0f} s, process + diagnose "
           f"{t['process_and_diagnose']:.0f} s ({t['jobs']} at a time)")
     if args.json:
-        args.json.write_text(json.dumps(result, indent=1) + "\n")
+        write_atomically(args.json, json.dumps(result, indent=1) + "\n")
     return exit_codes.OK

@@ -6,6 +6,18 @@ parameters is skipped without being read). Each result is stored with its decima
 traces (``run_results.traces``), which the report draws. A run with side-camera frames
 also gets its soil flow over the stable window (``softflow.flow_run``); frames that cannot
 be analysed are reported and recorded, and the run's other results are kept.
+
+Runs are processed outside any transaction and stored under the database's write lock
+(``traceability.database``), so several ``swtlab process`` may write one database at once.
+Versions (docs/results.md): a changed file is its run's new current version, another file
+claiming a stored run_id is refused unless ``--allow-run-id-reuse``, and stored files gone
+from CAMPAIGN are marked missing.
+
+A run that fails at any stage (it cannot be read, its results cannot be computed, the
+database refuses it) is listed with file, stage and reason, recorded (``swtlab results``
+shows it as ``failed``) and the batch goes on. Exit 0 when at least one run was processed
+or already up to date, 3 when none could be, 4 only for a fault outside any run (the
+database cannot be opened, for one).
 """
 
 from __future__ import annotations
@@ -20,7 +32,6 @@ from swtlab_cli import exit_codes
 from swtlab_cli.progress import progress
 
 
-
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
         "process", help="ingest and process every run of a campaign into the database",
@@ -33,27 +44,39 @@ def register(sub: argparse._SubParsersAction) -> None:
                     f"[rig_compliance] in CAMPAIGN/{CAMPAIGN_SETTINGS} or "
                     "--rig-compliance FILE (docs/run-results.md).")
     parser.add_argument("campaign", type=Path, help="folder of runs (any depth)")
-    parser.add_argument("--db", required=True, help="SQLAlchemy URL, e.g. sqlite:///swtlab.sqlite")
+    parser.add_argument("--db", required=True,
+                        help="database: SQLAlchemy URL (sqlite:///swtlab.sqlite, "
+                             "postgresql://user@host/db) or a SQLite file path; created or "
+                             "upgraded")
     parser.add_argument("--channel-map", help="TOML channel map (path or shipped name)")
     parser.add_argument("--rig-compliance", type=Path,
                         help="TOML file with a [rig_compliance] table (overrides the campaign's)")
+    parser.add_argument("--allow-run-id-reuse", action="store_true",
+                        help="store a file that claims the run_id of a run stored from another "
+                             "file as that run's new version (default: refused, naming both "
+                             "files)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     import ingest
-    from swtlab.pipeline.database import store_processed
-    from swtlab.pipeline.process import ProcessSettings, find_runs, process_file, rig_compliance
+    from swtlab.pipeline.database import store_one
+    from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
+                                         process_file, rig_compliance)
     from traceability import open_database
+    from traceability.database import in_transaction
     from traceability.hashing import content_sha256
+    from traceability.store import mark_missing
     from traceability.store_flow import stored_flow_failure
-    from traceability.store_results import params_sha256, processed_file
+    from traceability.store_results import params_sha256, processed_file, replace_uncertainty
+    from run_results.uncertainty_budget import pool_drift
 
     try:
         paths = find_runs(args.campaign, args.channel_map)
         settings = ProcessSettings(channel_map=args.channel_map,
-                                   rig=rig_compliance(args.campaign, args.rig_compliance))
+                                   rig=rig_compliance(args.campaign, args.rig_compliance),
+                                   budget=budget_params(args.campaign))
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
         print(f"swtlab process: {error}", file=sys.stderr)
         return exit_codes.BAD_INPUT
@@ -64,30 +87,50 @@ def run(args: argparse.Namespace) -> int:
     failed: list[str] = []
     flow_failed: list[str] = []
     flows = up_to_date = 0
+    new: list[tuple] = []   # (path, sha256, result) stored now: their drift is pooled below
     for path in progress(paths, desc="process", quiet=args.quiet):
-        sha256, _ = content_sha256(path)
-        with session_factory.begin() as session:
-            if processed_file(session, path, sha256, params_hash):
-                up_to_date += 1
-                known = stored_flow_failure(session, path, sha256, params_hash)
-                if known is not None:
-                    flow_failed.append(f"{path}: {known.channel}: {known.problem}")
-                continue
-            processed = process_file(path, settings)
-            stored = store_processed(session, processed, parameters)
-        failed += [f.reason for f in processed.failures if f.stage != "soil_flow"]
-        if processed.result is None:
+        try:
+            sha256, _ = content_sha256(path)
+        except OSError:
+            sha256 = None  # unreadable: process_file records why
+
+        def known(session, path=path, sha256=sha256):
+            if sha256 is None or not processed_file(session, path, sha256, params_hash):
+                return None
+            failure = stored_flow_failure(session, path, sha256, params_hash)
+            return [] if failure is None else [f"{path}: {failure.channel}: {failure.problem}"]
+
+        known_flow_failures = in_transaction(session_factory, known)
+        if known_flow_failures is not None:
+            up_to_date += 1
+            flow_failed += known_flow_failures
+            continue
+        processed = process_file(path, settings)  # outside any transaction: no lock held
+        stored = store_one(session_factory, processed, parameters,
+                           allow_run_id_reuse=args.allow_run_id_reuse)
+        failed += [f.reason if f.error_type == "IngestError" else f"{f.file}: {f.stage}: {f.reason}"
+                   for f in processed.failures if f.stage != "soil_flow"]
+        if processed.result is None or any(f.stage == "store" for f in processed.failures):
             continue
         if not stored:
             up_to_date += 1
             continue
         result = processed.result
+        new.append((path, sha256, result))
         flows += processed.flow is not None
         flow_failed += [f"{processed.run.source}: /camera/side: {f.reason}"
                         for f in processed.failures if f.stage == "soil_flow"]
         reasons = "; ".join(result.flags)
         statuses.setdefault(result.status, []).append(
             f"{result.run_id}: {reasons}" if reasons else result.run_id)
+    missing = in_transaction(session_factory, lambda session: [
+        f"{row.path} (run {row.run.run_id})" for row in mark_missing(session, args.campaign)])
+    if new:
+        def store_pooled(session):
+            for (path, sha256, _), pooled in zip(new, pool_drift([r for *_, r in new])):
+                replace_uncertainty(session, path, sha256, params_hash, pooled.uncertainty)
+
+        in_transaction(session_factory, store_pooled)
     done = sum(len(v) for v in statuses.values())
     print(f"processed {done} of {len(paths)} runs ({up_to_date} already up to date): "
           f"{len(statuses['ok'])} ok, {len(statuses['flagged'])} flagged, "
@@ -97,6 +140,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {status}: {line}")
     for line in failed:
         print(f"  failed: {line}")
+    for line in missing:
+        print(f"  missing: {line}: stored, but no longer in {args.campaign}; its results stay "
+              "listed, marked raw_file_missing")
     if flows or flow_failed:
         print(f"soil flow under the wheel (side camera): measured in {flows} runs"
               + (f", not measured in {len(flow_failed)}" if flow_failed else ""))

@@ -31,14 +31,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def _missing_sqlite_file(url: str) -> Path | None:
-    """The file of a sqlite URL when it does not exist (opening would create an empty one)."""
-    if url.startswith("sqlite:///") and url != "sqlite:///:memory:":
-        path = Path(url.removeprefix("sqlite:///"))
-        return None if path.is_file() else path
-    return None
-
-
 def run(args: argparse.Namespace) -> int:
     from sqlalchemy.exc import SQLAlchemyError
 
@@ -48,11 +40,6 @@ def run(args: argparse.Namespace) -> int:
     def bar(items: list, desc: str):
         return progress(items, desc=desc, quiet=args.quiet)
 
-    missing = _missing_sqlite_file(args.db)
-    if missing:
-        print(f"swtlab report: {missing}: no such database file (run swtlab process CAMPAIGN "
-              f"--db {args.db} first)", file=sys.stderr)
-        return exit_codes.BAD_INPUT
     try:
         if args.campaign:
             pages = {args.campaign: write_report(args.db, args.output, args.campaign, bar)}

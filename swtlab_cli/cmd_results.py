@@ -9,10 +9,15 @@ from pathlib import Path
 import pandas as pd
 
 from swtlab_cli import exit_codes
+from swtlab.atomic import atomic_file
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
-                   "window_start_s", "window_end_s", "slip_mean", "dp_n_mean", "dp_n_se",
-                   "torque_nm_mean", "sinkage_m_mean", "resistance_n_mean", "image_slip_mean"]
+                   "window_start_s", "window_end_s", "slip_mean", "slip_u95", "dp_n_mean",
+                   "dp_n_se", "dp_n_u95", "torque_nm_mean", "torque_nm_u95", "sinkage_m_mean",
+                   "sinkage_m_u95", "resistance_n_mean", "resistance_n_u95", "image_slip_mean"]
+
+REPLICATE_COLUMNS = ["wheel", "mode", "multipass", "load_set_n", "slip_setpoint", "quantity",
+                     "runs", "mean", "replicate_sd", "within_u", "ratio", "larger"]
 
 TOWED_COLUMNS = ["wheel", "soil", "multipass", "load_n", "towed_resistance_n",
                  "towed_resistance_se_n", "powered_resistance_at_zero_slip_n",
@@ -23,43 +28,88 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
         "results", help="list the results of every run in the database",
         description="One row per run: identifiers and conditions, status and flags, the stable "
-                    "window, and each quantity's mean, standard deviation and standard error in "
-                    "SI units (columns: docs/results.md). Without --csv/--json, a summary table.")
-    parser.add_argument("--db", required=True, help="SQLAlchemy URL")
+                    "window, and each quantity's mean, standard deviation, standard error and "
+                    "uncertainty budget (u, u95 = k u, terms) in SI units (columns: "
+                    "docs/results.md); runs that failed (status failed) with the stage, "
+                    "exception type and reason. Without --csv/--json, a summary table.")
+    parser.add_argument("--db", required=True,
+                        help="database URL or SQLite file path (read, never created or upgraded)")
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")
     out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
-    parser.add_argument("--towed", action="store_true",
-                        help="instead: motion resistance of the towed runs against powered runs "
-                             "at zero slip, per wheel, soil, multipass and load")
+    instead = parser.add_mutually_exclusive_group()
+    instead.add_argument("--towed", action="store_true",
+                         help="instead: motion resistance of the towed runs against powered runs "
+                              "at zero slip, per wheel, soil, multipass and load")
+    instead.add_argument("--replicates", action="store_true",
+                         help="instead: the spread of replicate runs (same condition) beside "
+                              "their within-run uncertainty, per condition and quantity")
     parser.set_defaults(func=run)
+
+
+def failed_rows(failures) -> pd.DataFrame:
+    """One row per failed run (``traceability.store_failures.current_failures``): status
+    ``failed``, the reason in ``flags`` and ``failure_reason``, the stage and exception type."""
+    return pd.DataFrame.from_records([{
+        "run_id": f.run_id or Path(f.path).stem, "status": "failed",
+        "flags": f"{f.stage} failed: {f.error}", "raw_file_path": f.path,
+        "raw_file_sha256": f.sha256, "failure_stage": f.stage,
+        "failure_type": f.error_type or "IngestError", "failure_reason": f.error}
+        for f in failures], columns=["run_id", "status", "flags", "raw_file_path",
+                                     "raw_file_sha256", "failure_stage", "failure_type",
+                                     "failure_reason"])
 
 
 def run(args: argparse.Namespace) -> int:
     from traceability import open_database
     from traceability.queries import latest_results
+    from traceability.store_failures import current_failures
 
-    with open_database(args.db)() as session:
+    with open_database(args.db, read_only=True)() as session:
         table = latest_results(session)
-    if table.empty:
+        failed = failed_rows(current_failures(session))
+    if table.empty and failed.empty:
         print(f"swtlab results: {args.db}: no processed runs (run swtlab process first)",
               file=sys.stderr)
         return exit_codes.BAD_INPUT
+    missing = table.loc[table["raw_file_missing"], "raw_file_path"] if len(table) else []
+    if len(missing):
+        print(f"swtlab results: notice: the raw files of {len(missing)} runs are missing "
+              f"(marked by swtlab process): {'; '.join(missing)}", file=sys.stderr)
     if args.towed:
         from run_results import towed_vs_powered
 
-        table = pd.DataFrame(towed_vs_powered(table))
+        table = pd.DataFrame(towed_vs_powered(table)) if len(table) else table
         if table.empty:
             print(f"swtlab results: {args.db}: no towed runs", file=sys.stderr)
             return exit_codes.BAD_INPUT
+        failed = failed.iloc[0:0]
+    if args.replicates:
+        from swtlab.domain.replicates import NO_REPLICATES, replicate_spread
+
+        table = replicate_spread(table) if len(table) else table
+        if table.empty:
+            print(f"swtlab results: {args.db}: {NO_REPLICATES}")
+            return exit_codes.OK
+        table = table.assign(run_ids=table["run_ids"].map(" ".join))
+        failed = failed.iloc[0:0]
+    every = pd.concat([t for t in (table, failed) if len(t)], ignore_index=True)
     if args.csv:
-        table.to_csv(args.csv, index=False)
-        print(f"{len(table)} runs written to {args.csv}")
+        with atomic_file(args.csv, newline="") as stream:
+            every.to_csv(stream, index=False)
+        print(f"{len(every)} runs written to {args.csv}"
+              + (f" ({len(failed)} failed)" if len(failed) else ""))
     elif args.json:
-        print(table.to_json(orient="records", indent=1))
+        print(every.to_json(orient="records", indent=1))
     elif args.towed:
         print(table[TOWED_COLUMNS].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-    else:
-        columns = [c for c in SUMMARY_COLUMNS if c in table.columns]
+    elif args.replicates:
+        columns = [c for c in REPLICATE_COLUMNS if c in table.columns]
         print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    else:
+        columns = [c for c in SUMMARY_COLUMNS if c in every.columns]
+        print(every[columns].to_string(index=False, na_rep="",
+                                       float_format=lambda v: f"{v:.4g}"))
+        for row in failed.itertuples():
+            print(f"failed: {row.run_id}: {row.flags} [{row.failure_type}]")
     return exit_codes.OK

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from swtlab_cli import exit_codes
+from swtlab.atomic import atomic_file
 
 COLUMNS = ["load_n", "multipass", "gravity_mps2", "slip", "dp_n", "torque_nm", "sinkage_m",
            "resistance_n", "thrust_n", "compaction_resistance_n", "fz_n", "fz_residual_n",
@@ -76,7 +77,11 @@ def run(args: argparse.Namespace) -> int:
     table = pd.DataFrame({k: curves[k] for k in COLUMNS + extra})
     if np.all(args.multipass == np.round(args.multipass)):
         table["multipass"] = table["multipass"].astype(int)
-    table.to_csv(args.output or sys.stdout, index=False, float_format="%.6g")
+    if args.output:
+        with atomic_file(args.output, newline="") as stream:
+            table.to_csv(stream, index=False, float_format="%.6g")
+    else:
+        table.to_csv(sys.stdout, index=False, float_format="%.6g")
     failed = int((~table["converged"]).sum())
     if args.output:
         print(f"swtlab sim: {len(table)} rows to {args.output}"

@@ -13,7 +13,7 @@ import sys
 from swtlab_cli import exit_codes
 
 SUBCOMMANDS = ["inspect", "process", "results", "export", "wpm", "report", "sim",
-               "track_slip", "flow", "gap", "gap_bench"]
+               "track_slip", "flow", "gap", "gap_bench", "migrate"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -32,6 +32,13 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _is_database_error(exc: Exception) -> bool:
+    """A database that cannot be used as asked (``traceability.database.UnusableDatabase``): the
+    user's input, not swtlab's fault. Checked without importing the database layer."""
+    database = sys.modules.get("traceability.database")
+    return database is not None and isinstance(exc, database.UnusableDatabase)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -44,6 +51,9 @@ def main(argv: list[str] | None = None) -> int:
         print("swtlab: interrupted", file=sys.stderr)
         return 130
     except Exception as exc:  # noqa: BLE001 - last line of defence, one line for the user
+        if _is_database_error(exc):
+            print(f"swtlab {args.command}: {exc}", file=sys.stderr)
+            return exit_codes.BAD_INPUT
         print(f"swtlab: internal error: {type(exc).__name__}: {exc} "
               "(rerun with SWTLAB_DEBUG=1 for the traceback)", file=sys.stderr)
         import os

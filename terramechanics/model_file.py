@@ -6,6 +6,7 @@ import dataclasses
 import tomllib
 from pathlib import Path
 
+from swtlab.atomic import write_atomically
 from terramechanics.effects import EFFECTS, make_effect
 from terramechanics.model import WheelModel
 from terramechanics.soil import SOILS, SoilParams
@@ -112,4 +113,4 @@ def save_model(model: WheelModel, path: str | Path) -> None:
                 lines += [f"{k} = {_toml_value(v)}" for k, v in params.items()]
         else:
             lines += ["", f"[{table}]"] + [f"{k} = {_toml_value(v)}" for k, v in content.items()]
-    Path(path).write_text("\n".join(lines).lstrip() + "\n")
+    write_atomically(path, "\n".join(lines).lstrip() + "\n")

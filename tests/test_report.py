@@ -3,7 +3,6 @@ curves with and without a WPM export, optional sections, the command line."""
 
 from __future__ import annotations
 
-import argparse
 import base64
 import json
 import re
@@ -22,7 +21,7 @@ from campaign_report.data import campaign_names, gather
 from campaign_report.extensions import Extension, optional_sections, register, unregister
 from campaign_report.html import Image, Note, Section
 from campaign_report.style import Palette
-from swtlab_cli import cmd_report, exit_codes
+from swtlab_cli import exit_codes
 from test_report_campaign import FLAG, FLAGGED_RUN, NO_STABLE_RUN, build_small_campaign
 from traceability import open_database
 from traceability.models import Campaign, Run, TestCondition, WpmExport
@@ -57,11 +56,10 @@ def _copy_db(url: str, folder: Path) -> str:
 
 
 def _cli(argv: list[str]) -> int:
-    """``swtlab report ...`` through its own parser (the command as main() registers it)."""
-    parser = argparse.ArgumentParser(prog="swtlab")
-    cmd_report.register(parser.add_subparsers())
-    args = parser.parse_args(["report", *argv])
-    return args.func(args)
+    """``swtlab report ...`` as the command line runs it (database errors are main()'s)."""
+    from swtlab_cli.main import main
+
+    return main(["report", *argv])
 
 
 def test_page_is_self_contained_and_every_image_decodes(small):

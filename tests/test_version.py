@@ -12,5 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_installed_version_is_pyprojects_and_the_newest_changelog_entry():
     declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
-    newest = re.search(r"^## (\S+)", (ROOT / "CHANGELOG.md").read_text(), re.M).group(1)
+    # the newest released entry; "## Unreleased" above it collects changes until the merge
+    newest = re.search(r"^## (?!Unreleased)(\S+)", (ROOT / "CHANGELOG.md").read_text(),
+                       re.M).group(1)
     assert importlib.metadata.version("swtlab") == declared == newest

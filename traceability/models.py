@@ -12,6 +12,14 @@ from sqlalchemy import (JSON, DateTime, Float, ForeignKey, Integer, LargeBinary,
                         UniqueConstraint)
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
 
+#: characters of a name users write (campaign, run_id, wheel, soil, topic, channel field);
+#: longer names are refused by ``traceability.text`` with a clear error, on every backend
+NAME_CHARS = 1000
+#: characters of a file path
+PATH_CHARS = 4096
+#: characters of a stored error message (longer ones are cut, with a mark)
+MESSAGE_CHARS = 2000
+
 
 class Base(DeclarativeBase):
     pass
@@ -33,7 +41,7 @@ class ProcessingRecord(Base):
 class Campaign(Base):
     __tablename__ = "campaign"
     id: Mapped[int] = mapped_column(primary_key=True)
-    name: Mapped[str] = mapped_column(String(200), unique=True)
+    name: Mapped[str] = mapped_column(String(NAME_CHARS), unique=True)
 
 
 class Wheel(Base):
@@ -43,7 +51,7 @@ class Wheel(Base):
     __table_args__ = (UniqueConstraint("name", "radius_m", "width_m", "grouser_count",
                                        "grouser_height_m", "stiffness_n_per_mm"),)
     id: Mapped[int] = mapped_column(primary_key=True)
-    name: Mapped[str] = mapped_column(String(200))
+    name: Mapped[str] = mapped_column(String(NAME_CHARS))
     radius_m: Mapped[float] = mapped_column(Float)
     width_m: Mapped[float] = mapped_column(Float)
     grouser_count: Mapped[int] = mapped_column(Integer)
@@ -55,7 +63,7 @@ class Wheel(Base):
 class Soil(Base):
     __tablename__ = "soil"
     id: Mapped[int] = mapped_column(primary_key=True)
-    name: Mapped[str] = mapped_column(String(200), unique=True)
+    name: Mapped[str] = mapped_column(String(NAME_CHARS), unique=True)
 
 
 class TestCondition(Base):
@@ -80,15 +88,19 @@ class TestCondition(Base):
 
 
 class Run(Base):
-    """One drive through the bin, identified by (campaign, run_id) from its metadata."""
+    """One drive through the bin, identified by (campaign, run_id) from its metadata (by its
+    content where the file names no run_id). ``current_version``: the raw-file version its
+    results and condition come from (the newest stored, or an older one the file was
+    reverted to)."""
 
     __tablename__ = "run"
     __table_args__ = (UniqueConstraint("campaign_id", "run_id"),)
     id: Mapped[int] = mapped_column(primary_key=True)
     campaign_id: Mapped[int] = mapped_column(ForeignKey("campaign.id"))
-    run_id: Mapped[str] = mapped_column(String(200))
+    run_id: Mapped[str] = mapped_column(String(NAME_CHARS))
     condition_id: Mapped[int] = mapped_column(ForeignKey("test_condition.id"))
     started_at: Mapped[datetime | None] = mapped_column(DateTime(timezone=True), nullable=True)
+    current_version: Mapped[int] = mapped_column(Integer)
 
     campaign: Mapped[Campaign] = relationship()
     condition: Mapped[TestCondition] = relationship()
@@ -97,20 +109,24 @@ class Run(Base):
 
 
 class RawFile(Base):
-    """One version of a run's raw file (or CSV run folder); a changed file is a new version."""
+    """One version of a run's raw file (or CSV run folder); a changed file is a new version.
+    ``missing_since``: when ``swtlab process`` of its folder found the file gone (None: there,
+    or never looked for)."""
 
     __tablename__ = "raw_file"
     __table_args__ = (UniqueConstraint("run_pk", "version"), UniqueConstraint("run_pk", "sha256"))
     id: Mapped[int] = mapped_column(primary_key=True)
     run_pk: Mapped[int] = mapped_column(ForeignKey("run.id"))
     version: Mapped[int] = mapped_column(Integer)
-    path: Mapped[str] = mapped_column(String(1000))
+    path: Mapped[str] = mapped_column(String(PATH_CHARS))
     size_bytes: Mapped[int] = mapped_column(Integer)
     sha256: Mapped[str] = mapped_column(String(64))
-    file_format: Mapped[str] = mapped_column(String(40))
+    file_format: Mapped[str] = mapped_column(String(NAME_CHARS))
     channel_summary: Mapped[dict] = mapped_column(JSON)
     problems: Mapped[list] = mapped_column(JSON)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
+    missing_since: Mapped[datetime | None] = mapped_column(DateTime(timezone=True),
+                                                          nullable=True)
 
     run: Mapped[Run] = relationship(back_populates="raw_files")
     processing: Mapped[ProcessingRecord] = relationship()
@@ -124,8 +140,8 @@ class Calibration(Base):
     id: Mapped[int] = mapped_column(primary_key=True)
     raw_file_id: Mapped[int] = mapped_column(ForeignKey("raw_file.id"))
     kind: Mapped[str] = mapped_column(String(20))  # "gain_offset" or "zero"
-    topic: Mapped[str] = mapped_column(String(200))
-    field: Mapped[str] = mapped_column(String(100))
+    topic: Mapped[str] = mapped_column(String(NAME_CHARS))
+    field: Mapped[str] = mapped_column(String(NAME_CHARS))
     gain: Mapped[float] = mapped_column(Float)
     offset: Mapped[float] = mapped_column(Float)
 
@@ -133,13 +149,18 @@ class Calibration(Base):
 
 
 class IngestFailure(Base):
-    """A file that could not be read, with its one-line reason (a batch report lists it)."""
+    """A file that could not be processed, with its one-line reason (a batch report lists it):
+    the ``stage`` that failed (``ingest``, ``results``, ``store``), the exception's class
+    ``error_type`` and the run's ``run_id`` where ingest got that far."""
 
     __tablename__ = "ingest_failure"
     id: Mapped[int] = mapped_column(primary_key=True)
-    path: Mapped[str] = mapped_column(String(1000))
+    path: Mapped[str] = mapped_column(String(PATH_CHARS))
     sha256: Mapped[str] = mapped_column(String(64))
-    error: Mapped[str] = mapped_column(String(2000))
+    error: Mapped[str] = mapped_column(String(MESSAGE_CHARS))
+    stage: Mapped[str] = mapped_column(String(20), default="ingest")
+    error_type: Mapped[str | None] = mapped_column(String(100), nullable=True)
+    run_id: Mapped[str | None] = mapped_column(String(NAME_CHARS), nullable=True)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
 
     processing: Mapped[ProcessingRecord] = relationship()
@@ -240,8 +261,8 @@ class CurveFit(Base):
     __tablename__ = "curve_fit"
     id: Mapped[int] = mapped_column(primary_key=True)
     fit_sha256: Mapped[str] = mapped_column(String(64), unique=True)
-    wheel: Mapped[str] = mapped_column(String(200))
-    soil: Mapped[str] = mapped_column(String(200))
+    wheel: Mapped[str] = mapped_column(String(NAME_CHARS))
+    soil: Mapped[str] = mapped_column(String(NAME_CHARS))
     multipass: Mapped[int] = mapped_column(Integer)
     load_n: Mapped[float] = mapped_column(Float)
     quantity: Mapped[str] = mapped_column(String(40))
@@ -272,7 +293,7 @@ class WpmExport(Base):
 
     __tablename__ = "wpm_export"
     id: Mapped[int] = mapped_column(primary_key=True)
-    path: Mapped[str] = mapped_column(String(1000))
+    path: Mapped[str] = mapped_column(String(PATH_CHARS))
     file_sha256: Mapped[str] = mapped_column(String(64))
     inputs_sha256: Mapped[str] = mapped_column(String(64))
     format_version: Mapped[str] = mapped_column(String(40))
@@ -294,7 +315,7 @@ class GapReport(Base):
 
     __tablename__ = "gap_report"
     id: Mapped[int] = mapped_column(primary_key=True)
-    sim_source: Mapped[str] = mapped_column(String(1000))
+    sim_source: Mapped[str] = mapped_column(String(PATH_CHARS))
     verdict: Mapped[list | str] = mapped_column(JSON)
     report: Mapped[dict] = mapped_column(JSON)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
@@ -375,9 +396,35 @@ class SoilFlowFailure(Base):
     id: Mapped[int] = mapped_column(primary_key=True)
     raw_file_id: Mapped[int] = mapped_column(ForeignKey("raw_file.id"))
     params_sha256: Mapped[str] = mapped_column(String(64))
-    channel: Mapped[str] = mapped_column(String(200))
-    problem: Mapped[str] = mapped_column(String(2000))
+    channel: Mapped[str] = mapped_column(String(NAME_CHARS))
+    problem: Mapped[str] = mapped_column(String(MESSAGE_CHARS))
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
 
     raw_file: Mapped[RawFile] = relationship()
     processing: Mapped[ProcessingRecord] = relationship()
+
+
+class RunUncertainty(Base):
+    """The uncertainty budget of one quantity of a run result
+    (``run_results.uncertainty_budget``): the correction added to the window mean, each
+    term's standard uncertainty (NULL: not in the budget), combined ``u``, effective degrees
+    of freedom (NULL: infinite), coverage factor ``k``, ``u95 = k u`` and what was not measured."""
+
+    __tablename__ = "run_uncertainty"
+    __table_args__ = (UniqueConstraint("run_result_id", "quantity"),)
+    id: Mapped[int] = mapped_column(primary_key=True)
+    run_result_id: Mapped[int] = mapped_column(ForeignKey("run_result.id"))
+    quantity: Mapped[str] = mapped_column(String(60))
+    unit: Mapped[str] = mapped_column(String(20))
+    correction: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_statistical: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_zero_drift: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_calibration: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_quantisation: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_phase_sampling: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_clock: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u: Mapped[float | None] = mapped_column(Float, nullable=True)
+    dof: Mapped[float | None] = mapped_column(Float, nullable=True)
+    k: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u95: Mapped[float | None] = mapped_column(Float, nullable=True)
+    not_measured: Mapped[list] = mapped_column(JSON)

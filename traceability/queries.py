@@ -6,33 +6,30 @@ import pandas as pd
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from swtlab.domain.results import COLUMNS, check_results, wheel_columns
+from swtlab.domain.results import COLUMNS, budget_columns, check_results, wheel_columns
 
-from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult, Soil,
-                                 StableWindow, TestCondition, Wheel)
+from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult,
+                                 RunUncertainty, Soil, StableWindow, TestCondition, Wheel)
 
 STATS = ("mean", "std", "se")
 
 
 def latest_results(session: Session) -> pd.DataFrame:
-    """Newest result of the newest raw-file version of every run, one row per run.
+    """Newest result of the current raw-file version of every run, one row per run (the
+    newest version, or an older one its file was reverted to).
 
     Columns are documented in docs/results.md: identifiers, conditions, status and
-    flags, the stable window, ``<quantity>_mean|_std|_se`` per quantity, and the
-    grouser oscillation.
+    flags, the stable window, ``<quantity>_mean|_std|_se`` per quantity, its uncertainty
+    budget ``<quantity>_u|_u95|_k|_dof|_correction|_u_<term>``, and the grouser oscillation.
     """
-    newest_file = (select(RawFile.run_pk, func.max(RawFile.version).label("version"))
-                   .group_by(RawFile.run_pk).subquery())
     newest_result = (select(RunResult.raw_file_id, func.max(RunResult.id).label("result_id"))
                      .group_by(RunResult.raw_file_id).subquery())
     rows = session.execute(
         select(Campaign.name, Run.run_id, RawFile.version, RawFile.path, RawFile.sha256,
-               Wheel, Soil.name, TestCondition, RunResult, StableWindow)
+               RawFile.missing_since, Wheel, Soil.name, TestCondition, RunResult, StableWindow)
         .join(Run.campaign).join(Run.condition).join(TestCondition.wheel)
         .join(TestCondition.soil)
-        .join(RawFile, RawFile.run_pk == Run.id)
-        .join(newest_file, (newest_file.c.run_pk == RawFile.run_pk)
-              & (newest_file.c.version == RawFile.version))
+        .join(RawFile, (RawFile.run_pk == Run.id) & (RawFile.version == Run.current_version))
         .join(newest_result, newest_result.c.raw_file_id == RawFile.id)
         .join(RunResult, RunResult.id == newest_result.c.result_id)
         .join(StableWindow, StableWindow.id == RunResult.stable_window_id)
@@ -44,13 +41,19 @@ def latest_results(session: Session) -> pd.DataFrame:
     for q in quantities:
         by_result.setdefault(q.run_result_id, {}).update(
             {f"{q.quantity}_{stat}": getattr(q, stat) for stat in STATS})
+    budgets = session.execute(select(RunUncertainty).where(
+        RunUncertainty.run_result_id.in_(result_ids))).scalars().all() if result_ids else []
+    for b in budgets:
+        by_result.setdefault(b.run_result_id, {}).update(budget_columns(b.quantity, {
+            c.key: getattr(b, c.key) for c in RunUncertainty.__table__.columns}))
     records = []
     for row in rows:
         cond, result, window = row.TestCondition, row.RunResult, row.StableWindow
         records.append({
             "campaign": row[0], "run_id": row.run_id, "raw_file_version": row.version,
             "raw_file_path": row.path, "raw_file_sha256": row.sha256,
-            **wheel_columns(row.Wheel), "soil": row[6], "mode": cond.mode,
+            "raw_file_missing": row.missing_since is not None,
+            **wheel_columns(row.Wheel), "soil": row[7], "mode": cond.mode,
             "multipass": cond.multipass,
             "load_set_n": cond.load_n, "slip_setpoint": cond.slip_setpoint,
             "velocity_set_mps": cond.velocity_mps, "gravity_mps2": cond.gravity_mps2,

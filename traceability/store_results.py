@@ -11,8 +11,9 @@ from sqlalchemy import select
 from sqlalchemy.orm import Session
 
 from plain_json import jsonable
+from swtlab.domain.results import UNCERTAINTY_TERMS
 from traceability.provenance import swtlab_version
-from traceability.models import IngestFailure, RawFile, RunQuantity, RunResult, StableWindow
+from traceability.models import RawFile, Run, RunQuantity, RunResult, RunUncertainty, StableWindow
 from traceability.store import new_processing_record
 from traceability.store_traces import store_traces
 
@@ -29,9 +30,11 @@ def find_result(session: Session, raw_file: RawFile, params_hash: str) -> RunRes
 
 
 def processed_file(session: Session, path: Path, sha256: str, params_hash: str) -> bool:
-    """Whether this exact file content at this path already has a result for these parameters."""
+    """Whether this exact file content at this path is its run's current version and has a
+    result for these parameters (a file reverted to an older version is not)."""
     return session.scalars(
         select(RunResult.id).join(RawFile, RawFile.id == RunResult.raw_file_id)
+        .join(Run, (Run.id == RawFile.run_pk) & (Run.current_version == RawFile.version))
         .where(RawFile.path == str(path.resolve()), RawFile.sha256 == sha256,
                RunResult.params_sha256 == params_hash)).first() is not None
 
@@ -57,17 +60,35 @@ def store_run_result(session: Session, raw_file: RawFile, result: Any,
     session.add(row)
     session.flush()
     store_traces(session, row, result.traces)
+    store_uncertainty(session, row, getattr(result, "uncertainty", {}))
     return row
 
 
-def store_ingest_failure(session: Session, path: Path, sha256: str, error: str,
-                         parameters: dict[str, Any]) -> None:
-    """Record a file that could not be read (once per path, content and message)."""
-    known = session.scalars(select(IngestFailure).filter_by(
-        path=str(path.resolve()), sha256=sha256, error=error)).first()
-    if known is None:
-        session.add(IngestFailure(path=str(path.resolve()), sha256=sha256, error=error,
-                                  processing=new_processing_record(session, "ingest", parameters)))
+def replace_uncertainty(session: Session, path: Path, sha256: str, params_hash: str,
+                        budgets: dict) -> bool:
+    """Replace the stored budgets of the result of this file content and parameters (after
+    the campaign's drift diffusion was pooled); whether there was such a result."""
+    raw_file = session.scalars(select(RawFile).filter_by(path=str(Path(path).resolve()),
+                                                         sha256=sha256)).first()
+    row = None if raw_file is None else find_result(session, raw_file, params_hash)
+    if row is None:
+        return False
+    for old in session.scalars(select(RunUncertainty).filter_by(run_result_id=row.id)).all():
+        session.delete(old)
+    session.flush()
+    store_uncertainty(session, row, budgets)
+    return True
+
+
+def store_uncertainty(session: Session, row: RunResult, budgets: dict) -> None:
+    """One ``RunUncertainty`` per quantity budget (``QuantityBudget``) of the result."""
+    for name, budget in budgets.items():
+        d = budget.to_dict()
+        session.add(RunUncertainty(
+            run_result_id=row.id, quantity=name, unit=d["unit"],
+            not_measured=list(d["not_measured"]),
+            **{k: _num(d[k]) for k in ("correction", *(f"u_{t}" for t in UNCERTAINTY_TERMS),
+                                       "u", "dof", "k", "u95")}))
 
 
 def _num(value: Any) -> float | None:

@@ -41,6 +41,7 @@ import numpy as np
 
 import terramechanics as tm
 from sim_gap.vocabulary import EFFECT_NAMES
+from swtlab.atomic import write_atomically
 from swtlab.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
 
 TRUTH_LAWS = ("in-family", "held-out")
@@ -181,12 +182,12 @@ def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
     with ProcessPoolExecutor(workers) as pool:
         list(pool.map(_generate, jobs))
     for i in range(n):
-        (workdir / f"c{i:03d}" / "laws.txt").write_text(
-            laws_option(diagnosis_laws(i, truth_laws)) + "\n")
+        write_atomically(workdir / f"c{i:03d}" / "laws.txt",
+                         laws_option(diagnosis_laws(i, truth_laws)) + "\n")
     labels = {f"c{i:03d}": {**label, "truth_laws": truth_laws, "signal_model": signal_model}
               for i, (_, label) in enumerate(truths)}
     path = workdir / "labels" / "labels.json"
-    path.write_text(json.dumps(labels, indent=1) + "\n")
+    write_atomically(path, json.dumps(labels, indent=1) + "\n")
     return path
 
 
@@ -303,8 +304,8 @@ def rediagnose(workdir: Path, truth_laws: str, jobs: int = 2, boot: int = 50) ->
     labels = workdir / "labels" / "labels.json"
     n = len(json.loads(labels.read_text()))
     for i in range(n):
-        (workdir / f"c{i:03d}" / "laws.txt").write_text(
-            laws_option(diagnosis_laws(i, truth_laws)) + "\n")
+        write_atomically(workdir / f"c{i:03d}" / "laws.txt",
+                         laws_option(diagnosis_laws(i, truth_laws)) + "\n")
     return _diagnose_and_score(labels, workdir, n, jobs, boot, False, truth_laws, 0.0)
 
 
@@ -319,5 +320,5 @@ def _diagnose_and_score(labels: Path, workdir: Path, n: int, jobs: int, boot: in
     out = {**score(labels, workdir), "truth_laws": truth_laws}
     out["timing_s"] = {"generate": generate_s, "process_and_diagnose": t2 - t1,
                        "per_campaign_mean": float(np.mean(seconds)), "jobs": jobs}
-    (workdir / f"score-{truth_laws}.json").write_text(json.dumps(out, indent=1) + "\n")
+    write_atomically(workdir / f"score-{truth_laws}.json", json.dumps(out, indent=1) + "\n")
     return out

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from swtlab.atomic import write_atomically
 from virtual_testbed.conditions import RunCondition
 from virtual_testbed.lateral import LateralLaw
 from virtual_testbed.law import PerformanceLaw, bb2_sand_law
@@ -132,7 +133,7 @@ def write_run(raw: RawRun, truth: dict, out_dir: Path) -> Path:
     (write_mcap if truth["form"] == "mcap" else write_csv)(raw, path)
     truth_path = Path(out_dir) / "truth" / f"{raw.run_id}.json"
     truth_path.parent.mkdir(parents=True, exist_ok=True)
-    truth_path.write_text(json.dumps(truth) + "\n")
+    write_atomically(truth_path, json.dumps(truth) + "\n")
     return path
 
 

@@ -46,6 +46,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from swtlab.atomic import atomic_file, write_atomically
+
 TRUTH_SCHEMA = "swtlab.virtual_testbed.flow_render/1"
 GROUSER_MODELS = ("piecewise", "cosine", "cosine_series", "gear")
 
@@ -450,8 +452,9 @@ def write_flow_render(render: FlowRender, folder: str | Path, fmt: str = "png") 
               "wheel": {"radius_m": sc.wheel_radius_px / sc.px_per_m,
                         "grouser_count": sc.grouser_count,
                         "grouser_height_m": sc.grouser_height_px / sc.px_per_m}}
-    (folder / "run.json").write_text(json.dumps(record, indent=2))
-    (folder / "flow_truth.json").write_text(json.dumps(render.truth, indent=2))
-    np.savez_compressed(folder / "flow_truth.npz", displacement_px=render.displacement_px,
-                        soil_mask=render.soil_mask)
+    write_atomically(folder / "run.json", json.dumps(record, indent=2))
+    write_atomically(folder / "flow_truth.json", json.dumps(render.truth, indent=2))
+    with atomic_file(folder / "flow_truth.npz", "wb") as stream:
+        np.savez_compressed(stream, displacement_px=render.displacement_px,
+                            soil_mask=render.soil_mask)
     return frames_dir

@@ -21,6 +21,7 @@ import cv2
 import numpy as np
 from scipy.ndimage import gaussian_filter1d, maximum_filter1d, uniform_filter1d
 
+from swtlab.atomic import write_atomically
 from virtual_testbed.rig import BB2_WHEEL
 
 TRUTH_SCHEMA = "swtlab.virtual_testbed.track_render/1"
@@ -260,8 +261,10 @@ def write_track_render(path: str | Path, slip: float, **kwargs) -> tuple[Path, P
     """Render and write ``path`` (PNG) and its truth apart as ``<stem>.truth.json``."""
     path = Path(path)
     image, truth = render_track(slip, **kwargs)
-    if not cv2.imwrite(str(path), image):
-        raise OSError(f"could not write {path}")
+    encoded, data = cv2.imencode(Path(path).suffix or ".png", image)
+    if not encoded:
+        raise OSError(f"could not encode {path}")
+    write_atomically(path, data.tobytes())
     truth_path = path.with_suffix(".truth.json")
-    truth_path.write_text(json.dumps(truth, indent=1))
+    write_atomically(truth_path, json.dumps(truth, indent=1))
     return path, truth_path

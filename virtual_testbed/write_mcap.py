@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
+from swtlab.atomic import atomic_file
 from virtual_testbed.measure import RawRun
 from virtual_testbed.topics import TOPIC_FIELDS
 
@@ -66,7 +67,7 @@ def write_mcap(raw: RawRun, path: Path) -> Path:
     started = datetime.fromisoformat(raw.metadata["run"]["started_at"].replace("Z", "+00:00"))
     epoch_ns = int(started.timestamp()) * 1_000_000_000
     messages = []
-    with open(path, "wb") as stream:
+    with atomic_file(path, "wb") as stream:
         writer = Writer(stream, chunk_size=CHUNK_SIZE_BYTES, compression=CompressionType.ZSTD)
         writer.start(profile="", library=LIBRARY)
         for topic in raw.channels:

@@ -6,16 +6,14 @@ import csv
 import hashlib
 import io
 import json
-import os
-import tempfile
 from collections.abc import Iterable
-from pathlib import Path
 
 import pandas as pd
 
 from fitting.curve import CurveFit
 from fitting.table import KEY_COLUMNS, MEASURED
 from wpm_export.reader import parse_wpm_csv
+from swtlab.atomic import write_atomically
 from swtlab.domain import Wheel
 from wpm_export.schema import (BRANCH_COLUMNS, COLUMNS, FORMAT, MAX_DEGREE, UNITS,
                                WHEEL_GEOMETRY_KEY, WHEEL_KEYS)
@@ -94,17 +92,8 @@ def wpm_csv_text(fits: Iterable[CurveFit], inputs_sha256: str, swtlab_version: s
 
 def write_wpm_csv(fits: Iterable[CurveFit], path, inputs_sha256: str, swtlab_version: str,
                   created: str | None = None, wheels: dict[str, Wheel] | None = None) -> str:
-    """Write the WPM CSV to ``path`` (UTF-8, ``\\n`` line ends) atomically (a temporary file
-    beside it, then ``os.replace``); return the file's sha256."""
+    """Write the WPM CSV to ``path`` (UTF-8, ``\\n`` line ends) atomically
+    (``swtlab.atomic``); return the file's sha256."""
     data = wpm_csv_text(fits, inputs_sha256, swtlab_version, created, wheels).encode("utf-8")
-    path = Path(path)
-    handle, temp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        os.fchmod(handle, 0o644)
-        with os.fdopen(handle, "wb") as out:
-            out.write(data)
-        os.replace(temp, path)
-    except BaseException:
-        Path(temp).unlink(missing_ok=True)
-        raise
+    write_atomically(path, data)
     return hashlib.sha256(data).hexdigest()

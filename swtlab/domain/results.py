@@ -5,7 +5,9 @@
 Set load and measured load are apart: ``load_set_n`` is the set point (the group key of the
 curves), ``wheel_load_n_mean`` the load measured over the stable window. Every quantity
 ``q`` has ``q_mean``, ``q_std`` (spread of the samples) and ``q_se`` (standard error of the
-mean, corrected for autocorrelation).
+mean, corrected for autocorrelation), and its uncertainty budget (:data:`BUDGET_COLUMNS`):
+``q_u`` (combined standard uncertainty), ``q_u95`` (95 % expanded), ``q_k``, ``q_dof``,
+``q_correction`` (re-zeroing added to the mean) and ``q_u_<term>``.
 """
 
 from __future__ import annotations
@@ -48,6 +50,18 @@ QUANTITIES: dict[str, str] = {
     "resistance_n": "N", "sinkage_m": "m", "hub_height_m": "m", "side_force_n": "N",
     "slip_angle_deg": "deg", "image_slip": "1",
 }
+
+#: terms of a quantity's uncertainty budget (``run_results.uncertainty_budget``)
+UNCERTAINTY_TERMS = ("statistical", "zero_drift", "calibration", "quantisation",
+                     "phase_sampling", "clock")
+#: results-table columns of a quantity's budget, ``<q>_<name>`` (docs/results.md)
+BUDGET_COLUMNS = ("u", "u95", "k", "dof", "correction", *(f"u_{t}" for t in UNCERTAINTY_TERMS))
+
+
+def budget_columns(quantity: str, budget: dict) -> dict:
+    """A budget (``QuantityBudget.to_dict()``, or as stored) as results-table columns."""
+    return {f"{quantity}_{name}": budget.get(name) for name in BUDGET_COLUMNS}
+
 
 #: wheel columns of the table -> fields of :class:`Wheel`
 WHEEL_COLUMNS = {"wheel_radius_m": "radius_m", "wheel_width_m": "width_m",

@@ -14,11 +14,33 @@ from swtlab.domain import Wheel, check_results, wheels_of
 @dataclass(frozen=True)
 class Failure:
     """A run (or part of one) that could not be processed: the ``file``, the ``stage``
-    (``ingest``, ``results``, ``soil_flow``) and the one-line ``reason``."""
+    (``ingest``, ``results``, ``soil_flow``, ``store``), the one-line ``reason`` and the
+    ``error_type``, the exception's class name (``IngestError`` for a run ingest refused with
+    its own message; any other type is a fault of swtlab inside that run: please report it)."""
 
     file: str
     stage: str
     reason: str
+    error_type: str = "IngestError"
+
+    @classmethod
+    def of(cls, file: str | Path, stage: str, error: BaseException) -> Failure:
+        """The failure of ``stage`` on ``file`` from the exception it raised: its own message
+        for an ``IngestError``, else ``internal error (<type>: <message>)``, on one line."""
+        kind = type(error).__name__
+        text = str(error) if kind == "IngestError" else f"internal error ({kind}: {error})"
+        return cls(str(file), stage, one_line(text), kind)
+
+
+#: longest failure reason kept (a message quoting a huge value is cut, never the file name)
+MAX_REASON_CHARS = 500
+
+
+def one_line(text: str) -> str:
+    """``text`` on one line (runs of blanks and line breaks become one space), at most
+    :data:`MAX_REASON_CHARS` characters."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= MAX_REASON_CHARS else text[:MAX_REASON_CHARS - 3] + "..."
 
 
 @dataclass
@@ -62,6 +84,29 @@ class Campaign:
     def wheels(self) -> dict[str, Wheel]:
         """Wheel name -> geometry, from the results."""
         return wheels_of(self.results) if len(self.results) else {}
+
+    @property
+    def replicates(self) -> pd.DataFrame:
+        """Spread of the replicate runs beside their within-run uncertainty, per condition and
+        quantity (``swtlab.domain.replicates.replicate_spread``); empty without replicates."""
+        from swtlab.domain.replicates import replicate_spread
+
+        return replicate_spread(self.results)
+
+    @property
+    def repeatability(self) -> str:
+        """One line: how many conditions have replicates, or that the campaign has none."""
+        from swtlab.domain.replicates import NO_REPLICATES, REPLICATE_KEY
+
+        spread = self.replicates
+        if spread.empty:
+            return NO_REPLICATES
+        conditions = spread[[c for c in REPLICATE_KEY if c in spread]].drop_duplicates()
+        larger = spread.groupby("quantity", sort=False)["larger"].apply(
+            lambda x: (x == "replicates").mean())
+        return (f"{len(conditions)} condition(s) with replicate runs; the replicate spread "
+                "exceeds the within-run uncertainty in "
+                + ", ".join(f"{q} {100 * v:.0f} %" for q, v in larger.items()) + " of them")
 
     @property
     def names(self) -> list[str]:

@@ -10,24 +10,29 @@ from pathlib import Path
 
 from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
 
-#: the campaign's settings file (``[rig_compliance]``, docs/run-results.md)
+#: the campaign's settings file (``[rig_compliance]``, ``[uncertainty]``, docs/run-results.md)
 CAMPAIGN_SETTINGS = "swtlab.toml"
 
 
 @dataclass(frozen=True)
 class ProcessSettings:
     """How runs are processed: channel map, rig compliance (``run_results.RigCompliance`` or
-    None), stable-phase parameters, side-camera frames per flow (0: no soil flow)."""
+    None), stable-phase parameters, side-camera frames per flow (0: no soil flow), what the
+    uncertainty budget is told (``run_results.uncertainty_budget.BudgetParams``)."""
 
     channel_map: str | None = None
     rig: object = None
     stable: object = None
     max_frames: int | None = None
+    budget: object = None
 
     def __post_init__(self) -> None:
+        from run_results.uncertainty_budget import BudgetParams
         from softflow.flow_run import MAX_FRAMES
         from stable_phase import StablePhaseParams
 
+        if self.budget is None:
+            object.__setattr__(self, "budget", BudgetParams())
         if self.stable is None:
             object.__setattr__(self, "stable", StablePhaseParams())
         if self.max_frames is None:
@@ -37,12 +42,14 @@ class ProcessSettings:
         """The parameters recorded with (and hashed into) every stored result."""
         return {"stable_phase": self.stable.to_dict(), "channel_map": self.channel_map,
                 "rig_compliance": self.rig.to_dict() if self.rig else None,
-                "flow": {"max_frames": self.max_frames}}
+                "flow": {"max_frames": self.max_frames},
+                "uncertainty": self.budget.to_dict()}
 
 
 def rig_compliance(folder: Path, path: Path | None = None):
     """The ``[rig_compliance]`` of ``path``, else of ``folder/swtlab.toml``; None when neither
-    file exists. A named file that is missing, or a file without the table, is an error."""
+    file exists or the campaign's file has no such table (it may hold ``[uncertainty]``
+    alone). A named file that is missing, or without the table, is an error."""
     from run_results import RigCompliance
 
     source = Path(path) if path else Path(folder) / CAMPAIGN_SETTINGS
@@ -51,9 +58,24 @@ def rig_compliance(folder: Path, path: Path | None = None):
             raise FileNotFoundError(f"{source}: no such file")
         return None
     table = tomllib.loads(source.read_text()).get("rig_compliance")
+    if table is None and not path:
+        return None
     if table is None:
         raise ValueError(f"{source}: no [rig_compliance] table")
     return RigCompliance.from_dict(table)
+
+
+def budget_params(folder: Path):
+    """The ``[uncertainty]`` of ``folder/swtlab.toml`` (``clock_rate_bound_ppm``: the loggers'
+    stated clock tolerance) as ``BudgetParams``; nothing stated without the file or table."""
+    from run_results.uncertainty_budget import BudgetParams
+
+    source = Path(folder) / CAMPAIGN_SETTINGS
+    table = tomllib.loads(source.read_text()).get("uncertainty", {}) if source.is_file() else {}
+    unknown = sorted(set(table) - {"clock_rate_bound_ppm"})
+    if unknown:
+        raise ValueError(f"{source}: [uncertainty] has unknown key(s) {unknown}")
+    return BudgetParams(**{k: float(v) for k, v in table.items()})
 
 
 def _soil_flow(done: ProcessedRun, settings: ProcessSettings) -> None:
@@ -66,11 +88,10 @@ def _soil_flow(done: ProcessedRun, settings: ProcessSettings) -> None:
     try:
         flow = run_flow(done.run, window.start_s, window.end_s, settings.max_frames)
     except FlowRunError as error:
-        done.failures.append(Failure(str(done.path), "soil_flow", error.problem))
+        done.failures.append(Failure(str(done.path), "soil_flow", error.problem, "FlowRunError"))
         return
     except Exception as error:  # noqa: BLE001 - one run's camera must not stop the batch
-        done.failures.append(Failure(str(done.path), "soil_flow", "internal error in the flow "
-                                     f"analysis ({type(error).__name__}: {error})"))
+        done.failures.append(Failure.of(done.path, "soil_flow", error))
         return
     if flow is not None:
         done.flow, done.flow_npz = flow, pack_flow(flow.result, flow.first_frame)
@@ -86,25 +107,20 @@ def process_file(path: Path, settings: ProcessSettings) -> ProcessedRun:
     from traceability.hashing import content_sha256
 
     path = Path(path)
-    done = ProcessedRun(path=path, sha256=content_sha256(path)[0])
+    done = ProcessedRun(path=path, sha256="")
     try:
+        done.sha256 = content_sha256(path)[0]
         done.run = ingest.read_run(path, channel_map=settings.channel_map)
         done.streams = report(done.run)["streams"]
-    except ingest.IngestError as error:
-        done.run = None
-        done.failures.append(Failure(str(path), "ingest", str(error)))
-        return done
     except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
         done.run = None
-        done.failures.append(Failure(str(path), "ingest",
-                                     f"internal error ({type(error).__name__}: {error})"))
+        done.failures.append(Failure.of(path, "ingest", error))
         return done
     try:
         done.result = process_run(done.run, settings.stable, settings.rig,
-                                  run_image_slip(done.run))
+                                  run_image_slip(done.run), settings.budget)
     except Exception as error:  # noqa: BLE001
-        done.failures.append(Failure(str(path), "results",
-                                     f"internal error ({type(error).__name__}: {error})"))
+        done.failures.append(Failure.of(path, "results", error))
         return done
     _soil_flow(done, settings)
     return done
@@ -115,9 +131,14 @@ def _process(args: tuple[Path, ProcessSettings]) -> ProcessedRun:
 
 
 def campaign_of(runs: list[ProcessedRun], parameters: dict) -> Campaign:
-    """The :class:`Campaign` of processed runs (results table of the runs with a result)."""
+    """The :class:`Campaign` of processed runs (results table of the runs with a result); the
+    load cells' drift diffusion of the uncertainty budgets is pooled over these runs."""
     from run_results import results_table
+    from run_results.uncertainty_budget import pool_drift
 
+    done = [r for r in runs if r.result is not None]
+    for r, pooled in zip(done, pool_drift([r.result for r in done])):
+        r.result = pooled
     table = results_table([r.result for r in runs if r.result is not None])
     sources = {r.result.run_id: r for r in runs if r.result is not None}
     if len(table):
@@ -167,7 +188,8 @@ def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: i
         paths = [p for p in paths if _name(p) in set(runs)]
     settings = ProcessSettings(channel_map=channel_map,
                                rig=rig_compliance(Path(folder), rig_compliance_file),
-                               max_frames=None if soil_flow else 0)
+                               max_frames=None if soil_flow else 0,
+                               budget=budget_params(Path(folder)))
     work = [(p, settings) for p in paths]
     if jobs > 1:
         with ProcessPoolExecutor(min(jobs, len(work))) as pool:

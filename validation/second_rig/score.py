@@ -2,7 +2,8 @@
 
 Input: the rows of ``swtlab results --json`` (one per run) and the truth folder. For each run
 and quantity: ``error = mean - truth``, ``z = error/SE``
-and whether ``mean +- 1.96 SE`` covers the truth; also ``z`` after taking out what the
+and whether ``mean +- 1.96 SE`` covers the truth, and whether the budget's ``mean +- u95``
+does (``covered_u95``, where the rows carry ``<q>_u95``); also ``z`` after taking out what the
 instruments alone add (load-cell drift over the window, gain and offset errors, encoder clock
 rates: ``z_instrument_out``; diagnostic only: it reads the truth, no estimator can), which
 leaves the estimators' own errors (window, transient, SE, quantisation).
@@ -75,20 +76,24 @@ def score(rows: Iterable[Mapping], truth_dir: str | Path, target: str = "steady"
                 continue
             true = truth[target][q]
             error = mean - true
+            u95 = row.get(f"{q}_u95")
             out.append({"run_id": row["run_id"], "mode": row["mode"], "quantity": q,
                         "mean": mean, "se": se, "truth": true, "error": error,
                         "z": error / se if se > 0 else float("inf"),
                         "covered": abs(error) <= 1.96 * se,
+                        "covered_u95": None if u95 is None else abs(error) <= u95,
                         "z_instrument_out": (error - _instrument_error(q, truth, target)) / se
                         if se > 0 else float("inf")})
     return pd.DataFrame(out)
 
 
 def coverage(scores: pd.DataFrame) -> pd.DataFrame:
-    """Per quantity: runs, coverage of ``mean +- 1.96 SE``, median and spread of z, the same
-    coverage with the instruments' errors taken out, and the median |error|."""
+    """Per quantity: runs, coverage of ``mean +- 1.96 SE``, of ``mean +- u95`` (the budget),
+    median and spread of z, the same coverage with the instruments' errors taken out, and the
+    median |error|."""
     def summary(g: pd.DataFrame) -> pd.Series:
         return pd.Series({"runs": len(g), "coverage": g["covered"].mean(),
+                          "coverage_u95": g["covered_u95"].dropna().astype(float).mean(),
                           "z_median": g["z"].median(), "z_std": g["z"].std(),
                           "coverage_instrument_out": (g["z_instrument_out"].abs() <= 1.96).mean(),
                           "abs_error_median": g["error"].abs().median()})

@@ -1,0 +1,437 @@
+"""Uncertainty budget of every run quantity (GUM, JCGM 100:2008): the terms, their
+combination, the effective degrees of freedom and the 95 % expanded uncertainty.
+
+Terms (standard uncertainties in the quantity's unit, each with its degrees of freedom):
+
+- ``statistical``: the window's autocorrelation-corrected SE (``run_results.stats``),
+  ``nu = n_eff - 1`` (Type A, GUM 4.2). For the rates derived from encoder positions (slip,
+  travel velocity, wheel speed) the batch-means SE with its lag-1 autocovariance
+  (``run_results.stats.batch_means_se``, ``B - 2`` degrees of freedom) instead: the
+  derivative filter's noise is anti-correlated at short lags, so the autocorrelation sum,
+  which stops at the first negative pair, counts that noise in full and still ends before
+  a slow ripple of the drives is seen.
+- ``zero_drift``: the load cells' zero at the window, from the rest readings
+  (``run_results.rest_readings``). DP, torque and side force read zero at rest; the zero is
+  taken as linear in time between the two rests and subtracted (the ``correction``, GUM
+  3.2.3). ``fz`` carries the wheel's actual load at rest, which is what it measures, so only
+  its change between the rests is drift: the line starts at zero at the first rest (the
+  spec's ``swt.zero`` stays its absolute zero; taking the set load as the rest value would
+  make the measured load equal the set load by construction, and hide a saturated cell).
+  Its uncertainty: the rests' SEs, and the drift's
+  departure from the line over the window, modelled as a Brownian bridge between the rests
+  (variance ``beta sigma^2 T`` of its window mean, :func:`bridge_factor`). The diffusion
+  ``sigma^2`` of each cell is pooled over the runs of a campaign from their changes between
+  the rests, ``sum(D^2 - se0^2 - se1^2) / sum(T)`` (:func:`pooled_diffusion`, one degree of
+  freedom per run, GUM 4.2.4); a run alone has only its own ``D^2 / T``, one degree of freedom.
+  Without two rests nothing is subtracted and the term is listed as not measured
+  (``swt.zero`` alone says nothing about the drift since the zeroing).
+- ``calibration``: ``gain_rel_u`` times what the gain scales (the mean) and, where the
+  zero is not re-measured (``fz``, or no rests), ``offset_u`` (the spec's optional
+  ``swt.calibration`` keys; not stated: not measured).
+- ``quantisation``: of a step ``q`` read from the samples, ``q/sqrt(12)`` damped by
+  ``exp(-2 pi^2 s^2 / q^2)`` for samples spread by ``s`` (dithered by their own noise: the
+  first harmonic of the quantiser's mean error for Gaussian input, Widrow, Kollar & Liu 1996,
+  IEEE Trans. Instrum. Meas. 45(2) 353); load cells and the suspension arm.
+- ``phase_sampling``: a sensor sampling a sharp-edged grouser wave only ``m`` times a period
+  sees few of its phases; the rectangle rule over a period errs by at most ``drop / (2 m)``
+  for a jump ``drop`` (the largest step between adjacent phase bins of the waveform), a
+  bound taken as rectangular (GUM 4.3.7). Load cells and the suspension arm, with grousers.
+- ``clock``: the loggers' rate error, rectangular within ``+-clock_rate_bound_ppm`` (the
+  logger's stated clock tolerance), relative on speeds, ``(1 - |s|) sqrt(2) u`` on slip (the
+  wheel and sled encoders' clocks apart).
+
+Combined: root sum of squares of independent terms (GUM 5.1.2); effective degrees of freedom
+by Welch-Satterthwaite (GUM G.4.1); ``k`` the Student-t 97.5 % point (GUM G.3.2), or, with a
+rectangular clock term, the 97.5 % point of its convolution with the rest taken as normal
+(scaled by the t-factor), so a dominant rectangle is not given a normal's tails.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy import optimize, stats
+
+from run_results.native import MIN_SAMPLES_PER_BIN, channel_samples, hub_samples
+from run_results.phase_average import phase_average
+from run_results.rest_readings import RestReadings, resolution
+from run_results.stats import QuantityStats
+from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
+
+#: quantity -> (load-cell column, divide by the wheel radius?) for the single-cell quantities
+CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),
+           "thrust_n": ("ty_nm", True), "wheel_load_n": ("fz_n", False),
+           "side_force_n": ("fy_n", False)}
+#: spec topic and field of each load-cell column (for ``swt.calibration`` uncertainties)
+FIELD_OF = {"dp_n": ("/tether/force", "dp"), "ty_nm": ("/hub/wrench", "ty"),
+            "fz_n": ("/hub/wrench", "fz"), "fy_n": ("/hub/wrench", "fy")}
+SPEEDS = ("travel_velocity_mps", "wheel_omega_radps")
+#: the loggers' clock tolerance assumed where none is stated (a common quartz class)
+DEFAULT_CLOCK_PPM = 100.0
+#: rates derived from encoder positions (their statistical term also by batch means)
+RATES = ("slip", *SPEEDS)
+INF = math.inf
+
+
+@dataclass(frozen=True)
+class BudgetParams:
+    """What the budget is told about the rig: the loggers' clock tolerance (ppm, bound; None:
+    not stated, :data:`DEFAULT_CLOCK_PPM` is used and the budget says so)."""
+
+    clock_rate_bound_ppm: float | None = None
+
+    def __post_init__(self) -> None:
+        ppm = self.clock_rate_bound_ppm
+        if ppm is not None and not (math.isfinite(ppm) and ppm >= 0):
+            raise ValueError(f"clock_rate_bound_ppm {ppm} must be >= 0")
+
+    @property
+    def clock_ppm(self) -> float:
+        return DEFAULT_CLOCK_PPM if self.clock_rate_bound_ppm is None else self.clock_rate_bound_ppm
+
+    @property
+    def clock_missing(self) -> tuple[str, ...]:
+        return () if self.clock_rate_bound_ppm is not None else (
+            f"clock tolerance (not stated in swtlab.toml [uncertainty]: {DEFAULT_CLOCK_PPM:g} "
+            "ppm assumed)",)
+
+    def to_dict(self) -> dict:
+        return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm}
+
+
+@dataclass(frozen=True)
+class Term:
+    """One standard uncertainty with its degrees of freedom; ``rectangular``: a bound."""
+
+    u: float
+    dof: float = INF
+    rectangular: bool = False
+
+
+@dataclass(frozen=True)
+class DriftPart:
+    """A load cell's share of a quantity's zero: ``weight`` (quantity per cell unit), the
+    rests' means term (cell units), the time between the rests ``span_s``, the bridge factor
+    ``beta`` of the window and the run's own change ``change`` between the rests."""
+
+    column: str
+    weight: float
+    means: Term
+    span_s: float
+    beta: float
+    change: float
+
+    def term(self, diffusion: dict[str, Term]) -> Term:
+        """The zero-drift term, with the cell's pooled diffusion (per s) where given."""
+        own = Term(self.change**2 / self.span_s, 1.0)
+        sigma2 = diffusion.get(self.column, own)
+        bridge = Term(math.sqrt(self.beta * self.span_s * max(sigma2.u, 0.0)), sigma2.dof)
+        return _rss([Term(abs(self.weight) * self.means.u, self.means.dof),
+                     Term(abs(self.weight) * bridge.u, bridge.dof)])
+
+
+@dataclass(frozen=True)
+class QuantityBudget:
+    """One quantity's budget: the correction added to the window mean, the terms, what was
+    not measured, and the combined, effective-dof, coverage factor and expanded values.
+    ``drift``: the load cells' zero parts, from which the ``zero_drift`` term is made with
+    ``diffusion`` (column -> pooled ``sigma^2`` per s as a :class:`Term`; empty: each run's own)."""
+
+    unit: str
+    correction: float
+    terms: dict[str, Term]
+    not_measured: tuple[str, ...] = ()
+    drift: tuple[DriftPart, ...] = ()
+    diffusion: dict[str, Term] = field(default_factory=dict)
+    u: float = field(init=False)
+    dof: float = field(init=False)
+    k: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        if self.drift:
+            terms = {k: t for k, t in self.terms.items() if k != "zero_drift"}
+            terms["zero_drift"] = _rss([p.term(self.diffusion) for p in self.drift])
+            object.__setattr__(self, "terms", terms)
+        u, dof, k = combine(list(self.terms.values()))
+        object.__setattr__(self, "u", u)
+        object.__setattr__(self, "dof", dof)
+        object.__setattr__(self, "k", k)
+
+    @property
+    def u95(self) -> float:
+        return self.k * self.u
+
+    def to_dict(self) -> dict:
+        """JSON-ready: correction, ``u_<term>`` (None: not in the budget), u, dof (None:
+        infinite), k, u95, not_measured."""
+        return {"unit": self.unit, "correction": self.correction,
+                **{f"u_{name}": (self.terms[name].u if name in self.terms else None)
+                   for name in TERMS},
+                "u": self.u, "dof": None if math.isinf(self.dof) else self.dof, "k": self.k,
+                "u95": self.u95, "not_measured": list(self.not_measured)}
+
+
+def _rss(terms: list[Term]) -> Term:
+    """Root sum of squares, Welch-Satterthwaite degrees of freedom."""
+    u2 = sum(t.u**2 for t in terms)
+    den = sum(t.u**4 / t.dof for t in terms if t.u > 0 and not math.isinf(t.dof))
+    return Term(math.sqrt(u2), u2**2 / den if den > 0 else INF)
+
+
+def _t97(dof: float) -> float:
+    return 1.959963984540054 if math.isinf(dof) else float(stats.t.ppf(0.975, max(dof, 1.0)))
+
+
+def rect_normal_quantile(a: float, sigma: float, p: float = 0.975) -> float:
+    """``x`` with ``P(X <= x) = p`` for ``X = N(0, sigma^2) + U(-a, a)`` (exact CDF:
+    ``sigma/(2a) [G((x+a)/sigma) - G((x-a)/sigma)]``, ``G(z) = z Phi(z) + phi(z)``)."""
+    if a <= 0:
+        return float(stats.norm.ppf(p)) * sigma
+    if sigma <= 0:
+        return a * (2 * p - 1)
+
+    def cdf(x: float) -> float:
+        g = lambda z: z * stats.norm.cdf(z) + stats.norm.pdf(z)  # noqa: E731
+        return sigma / (2 * a) * (g((x + a) / sigma) - g((x - a) / sigma)) - p
+    hi = a + 10 * sigma
+    if not cdf(hi) > 0:  # sigma so small against a that the difference cancels: rectangular
+        return a * (2 * p - 1)
+    return float(optimize.brentq(cdf, 0.0, hi))
+
+
+def combine(terms: list[Term]) -> tuple[float, float, float]:
+    """``(u_c, nu_eff, k)`` of independent terms (module doc)."""
+    total = _rss(terms)
+    if total.u == 0:
+        return 0.0, INF, _t97(INF)
+    rect = [t for t in terms if t.rectangular]
+    if len(rect) != 1:
+        return total.u, total.dof, _t97(total.dof)
+    rest = _rss([t for t in terms if not t.rectangular])
+    sigma = rest.u * _t97(rest.dof) / _t97(INF)
+    return total.u, total.dof, rect_normal_quantile(rect[0].u * math.sqrt(3), sigma) / total.u
+
+
+def bridge_factor(p: float, q: float) -> float:
+    """Variance of the mean over ``[p, q]`` of a standard Brownian bridge on ``[0, 1]``
+    (``cov = min(u, v) - u v``): ``[q^3/3 - q p^2 + 2p^3/3 - ((q^2 - p^2)/2)^2] / (q - p)^2``."""
+    p, q = min(max(p, 0.0), 1.0), min(max(q, 0.0), 1.0)
+    if q <= p:
+        return p * (1 - p)
+    double = -(q**3 - p**3) / 6 + q * (q**2 - p**2) / 2 - p**2 * (q - p) / 2
+    return max(double - ((q**2 - p**2) / 2) ** 2, 0.0) / (q - p) ** 2
+
+
+@dataclass(frozen=True)
+class ZeroAtWindow:
+    """A cell's zero over the window: value and its drift part, or why it is not measured."""
+
+    zero: float
+    part: DriftPart | None
+    missing: str | None = None
+
+
+def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[float, float],
+                   rest_value: float | None) -> ZeroAtWindow:
+    """The zero of ``column`` over the window: the rests' means less ``rest_value`` (what the
+    cell carries at rest; None: not known, only the change since the first rest is drift),
+    linear in time between the rests, with its uncertainty (module doc)."""
+    if rests is None or column not in rests.before or column not in rests.after:
+        return ZeroAtWindow(0.0, None, "zero drift (no rest readings before and after the drive)")
+    b, a = rests.before[column], rests.after[column]
+    span = a.t_s - b.t_s
+    w = ((window_s[0] + window_s[1]) / 2 - b.t_s) / span
+    reference = b.stats.mean if rest_value is None else rest_value
+    d0, d1 = b.stats.mean - reference, a.stats.mean - reference
+    zero = d0 + (d1 - d0) * w
+    means = _rss([Term((1 - w) * b.stats.se, max(b.stats.n_eff - 1, 1)),
+                  Term(w * a.stats.se, max(a.stats.n_eff - 1, 1))])
+    beta = bridge_factor((window_s[0] - b.t_s) / span, (window_s[1] - b.t_s) / span)
+    return ZeroAtWindow(zero, DriftPart(column, 1.0, means, span, beta, d1 - d0))
+
+
+def pooled_diffusion(rest_records: list[dict]) -> dict[str, Term]:
+    """Per cell, the drift diffusion (per s) pooled over runs, ``sum(D^2 - se0^2 - se1^2) /
+    sum(T)`` with one degree of freedom per run; ``rest_records``: the runs'
+    ``RestReadings.to_dict()`` (None for a run without rests is skipped)."""
+    sums: dict[str, list[float]] = {}
+    for record in rest_records:
+        if not record:
+            continue
+        for column, b in record["before"].items():
+            a = record["after"].get(column)
+            if a is None or a["t_s"] <= b["t_s"]:
+                continue
+            acc = sums.setdefault(column, [0.0, 0.0, 0])
+            acc[0] += (a["mean"] - b["mean"]) ** 2 - b["se"] ** 2 - a["se"] ** 2
+            acc[1] += a["t_s"] - b["t_s"]
+            acc[2] += 1
+    return {c: Term(max(num, 0.0) / span, float(runs)) for c, (num, span, runs) in sums.items()}
+
+
+def _quantisation(q: float, spread: float) -> float:
+    if q <= 0:
+        return 0.0
+    return q / math.sqrt(12) * math.exp(-2 * math.pi**2 * (spread / q) ** 2)
+
+
+def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -> Term | None:
+    """Bound ``drop / (2 m)`` on the window mean of a periodic wave sampled ``m`` times a
+    period (module doc), as a rectangular term; None without a frequency or samples."""
+    if not frequency_hz or y.size < 2:
+        return None
+    average = phase_average(t_s, y, frequency_hz)
+    if y.size < MIN_SAMPLES_PER_BIN * average["bins"]:
+        return None
+    wave = average["waveform"][np.isfinite(average["waveform"])]
+    if wave.size < 2:
+        return None
+    drop = float(np.max(np.abs(np.diff(np.append(wave, wave[0])))))
+    per_period = 1.0 / (frequency_hz * float(np.median(np.diff(t_s))))
+    return Term(drop / (2.0 * per_period) / math.sqrt(3.0), rectangular=True)
+
+
+def _statistical(s: QuantityStats) -> Term:
+    return Term(float(s.se), max(float(s.n_eff) - 1.0, 1.0))
+
+
+def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
+                 frequency_hz: float | None) -> QuantityBudget:
+    """Budget of a single-cell quantity (thrust: the torque cell over the radius)."""
+    column, per_radius = CELL_OF[key]
+    scale = run.metadata.wheel.radius_m if per_radius else 1.0
+    absolute = column != "fz_n"  # fz at rest reads the actual load, which it measures
+    z = zero_at_window(rests, column, window_s, 0.0 if absolute else None)
+    missing = [] if z.missing is None else [z.missing]
+    terms = {"statistical": _statistical(s)}
+    drift = () if z.part is None else (replace(z.part, weight=1.0 / scale),)
+    mean = s.mean - z.zero / scale
+    gain_u, offset_u = run.metadata.calibration_u.get(FIELD_OF[column], (None, None))
+    if gain_u is None:
+        missing.append("calibration (no gain_rel_u / offset_u in swt.calibration)")
+    else:
+        offset = 0.0 if drift and absolute else offset_u / scale
+        terms["calibration"] = Term(math.hypot(gain_u * abs(mean), offset))
+    native = channel_samples(run, column, *window_s)
+    if native is not None:
+        terms["quantisation"] = Term(_quantisation(resolution(native[1]) / scale, s.std))
+        sampling = phase_sampling(native[0], native[1] / scale, frequency_hz)
+        if sampling is not None:
+            terms["phase_sampling"] = sampling
+    return QuantityBudget(s.unit, -z.zero / scale, terms, tuple(missing), drift)
+
+
+def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> QuantityBudget:
+    """Budget of ``sum(sign * part)`` with its own statistical term (cells independent)."""
+    terms = {"statistical": _statistical(s)}
+    for name in ("calibration", "quantisation", "phase_sampling"):
+        found = [Term(abs(sign) * b.terms[name].u, b.terms[name].dof) for b, sign in parts
+                 if name in b.terms]
+        if found:
+            terms[name] = _rss(found)
+    drift = tuple(replace(p, weight=sign * p.weight) for b, sign in parts for p in b.drift)
+    missing = tuple(sorted({m for b, _ in parts for m in b.not_measured}))
+    return QuantityBudget(s.unit, sum(sign * b.correction for b, sign in parts), terms,
+                          missing, drift)
+
+
+def _rate_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
+    """The batch-means statistical term, the autocorrelation one where it has none."""
+    return _statistical(s) if batch is None else Term(*batch)
+
+
+def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
+    """Statistics and the clock (the encoders' resolution, a step over the whole window,
+    is far below both)."""
+    terms = {"statistical": _rate_statistical(s, batch),
+             "clock": Term(abs(s.mean) * params.clock_ppm * 1e-6 / math.sqrt(3),
+                           rectangular=True)}
+    return terms
+
+
+def run_budget(run, window_s: tuple[float, float], quantities: dict[str, QuantityStats],
+               rests: RestReadings | None, params: BudgetParams | None = None,
+               batches: dict | None = None,
+               frequency_hz: float | None = None) -> tuple[dict[str, QuantityStats],
+                                                           dict[str, QuantityBudget]]:
+    """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
+    re-zeroing correction added (module doc); ``batches``: the rates' batch-means
+    ``(se, dof)`` (``run_results.stats.batch_means_se``); ``frequency_hz``: the grouser
+    passing frequency (None: no grousers)."""
+    params = params or BudgetParams()
+    batches = batches or {}
+    budgets: dict[str, QuantityBudget] = {}
+    for key, s in quantities.items():
+        if key in CELL_OF:
+            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz)
+    if "resistance_n" in quantities and "thrust_n" in budgets and "dp_n" in budgets:
+        budgets["resistance_n"] = _sum_budget(quantities["resistance_n"],
+                                              [(budgets["thrust_n"], 1.0),
+                                               (budgets["dp_n"], -1.0)])
+    for key in ("hub_height_m", "sinkage_m"):
+        if key in quantities:
+            budgets[key] = _height_budget(run, key, quantities[key], window_s, budgets,
+                                          frequency_hz)
+    for key in SPEEDS:
+        if key in quantities:
+            budgets[key] = QuantityBudget(quantities[key].unit, 0.0,
+                                          _speed_budget(quantities[key], params,
+                                                        batches.get(key)), params.clock_missing)
+    if "slip" in quantities:
+        s = quantities["slip"]
+        clock = (1 - min(abs(s.mean), 1.0)) * math.sqrt(2) * params.clock_ppm * 1e-6
+        budgets["slip"] = QuantityBudget(s.unit, 0.0, {"statistical": _rate_statistical(
+                                                            s, batches.get("slip")),
+                                                       "clock": Term(clock / math.sqrt(3))},
+                                         params.clock_missing)
+    for key, s in quantities.items():
+        budgets.setdefault(key, QuantityBudget(s.unit, 0.0, {"statistical": _statistical(s)},
+                                               ("only the window statistics",)))
+    corrected = {k: replace(s, mean=s.mean + budgets[k].correction) if budgets[k].correction
+                 else s for k, s in quantities.items()}
+    return corrected, budgets
+
+
+def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict,
+                   frequency_hz: float | None) -> QuantityBudget:
+    """Hub height: statistics and the arm encoder's quantisation; sinkage of a flexible wheel
+    also the wheel load's zero and calibration through ``fz / (1000 k)``."""
+    terms = {"statistical": _statistical(s)}
+    hub = hub_samples(run, *window_s)
+    if hub is not None:
+        terms["quantisation"] = Term(_quantisation(resolution(hub[1]), s.std))
+        sampling = phase_sampling(hub[0], hub[1], frequency_hz)
+        if sampling is not None:
+            terms["phase_sampling"] = sampling
+    stiffness = run.metadata.wheel.stiffness_n_per_mm
+    if key == "hub_height_m" or stiffness is None or "wheel_load_n" not in budgets:
+        return QuantityBudget(s.unit, 0.0, terms)
+    load = budgets["wheel_load_n"]
+    scale = -1.0 / (1000.0 * stiffness)
+    if "calibration" in load.terms:
+        terms["calibration"] = Term(load.terms["calibration"].u * abs(scale))
+    return QuantityBudget(s.unit, load.correction * scale, terms, load.not_measured,
+                          tuple(replace(p, weight=scale * p.weight) for p in load.drift))
+
+
+def with_diffusion(budgets: dict[str, QuantityBudget],
+                   diffusion: dict[str, Term]) -> dict[str, QuantityBudget]:
+    """The budgets with the campaign's pooled drift diffusion (:func:`pooled_diffusion`)."""
+    return {k: replace(b, diffusion=diffusion) if b.drift else b for k, b in budgets.items()}
+
+
+
+def pool_drift(results: list) -> list:
+    """``run_results.RunResult`` s with the drift diffusion pooled over the rest readings of
+    the runs of each campaign (``condition["campaign"]``, one rig's cells;
+    :func:`pooled_diffusion`); the means are unchanged."""
+    campaigns: dict = {}
+    for r in results:
+        campaigns.setdefault(r.condition.get("campaign"), []).append(
+            r.corrections.get("rest_readings"))
+    diffusion = {c: pooled_diffusion(records) for c, records in campaigns.items()}
+    return [replace(r, uncertainty=with_diffusion(r.uncertainty,
+                                                  diffusion[r.condition.get("campaign")]))
+            for r in results]

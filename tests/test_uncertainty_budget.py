@@ -1,0 +1,181 @@
+"""The uncertainty budget's parts against hand calculations and independent numerics
+(run_results.uncertainty_budget, run_results.rest_readings, run_results.stats)."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import integrate, stats
+
+from run_results.rest_readings import rest_readings, resolution
+from run_results.stats import batch_means_se
+from run_results.uncertainty_budget import (QuantityBudget, Term, bridge_factor, combine,
+                                            pooled_diffusion, rect_normal_quantile,
+                                            zero_at_window)
+from run_results.uncertainty_budget import _quantisation as quantisation
+
+
+def test_bridge_factor_matches_a_numerical_double_integral():
+    # Var of the mean of a standard Brownian bridge over [p, q]: (1/L^2) iint min(u,v) - uv
+    assert bridge_factor(0.0, 1.0) == pytest.approx(1 / 12)      # the known 1/12
+    assert bridge_factor(0.0, 0.5) == pytest.approx(5 / 48)      # by hand: 0.026042 / 0.25
+    for p, q in ((0.2, 0.9), (0.55, 0.95)):
+        value, _ = integrate.dblquad(lambda u, v: min(u, v) - u * v, p, q, p, q)
+        assert bridge_factor(p, q) == pytest.approx(value / (q - p) ** 2, rel=1e-6)
+
+
+def test_bridge_factor_against_simulated_bridges():
+    rng = np.random.default_rng(3)
+    n, runs = 400, 4000
+    walk = np.cumsum(rng.normal(0, math.sqrt(1 / n), (runs, n)), axis=1)
+    u = np.arange(1, n + 1) / n
+    bridge = walk - u * walk[:, -1:]
+    inside = (u >= 0.3) & (u <= 0.8)
+    assert np.var(bridge[:, inside].mean(axis=1)) == pytest.approx(bridge_factor(0.3, 0.8),
+                                                                   rel=0.08)
+
+
+def test_welch_satterthwaite_and_student_t():
+    # GUM G.4.1: u = sqrt(1 + 4) , nu = 25 / (1/4 + 16/inf) = 100
+    u, dof, k = combine([Term(1.0, 4.0), Term(2.0)])
+    assert u == pytest.approx(math.sqrt(5)) and dof == pytest.approx(100.0)
+    assert k == pytest.approx(stats.t.ppf(0.975, 100))
+    assert combine([Term(3.0), Term(4.0)]) == pytest.approx((5.0, math.inf, 1.959964))
+
+
+def test_rectangle_plus_normal_quantile_against_monte_carlo():
+    assert rect_normal_quantile(1.0, 0.0) == pytest.approx(0.95)          # a rectangle alone
+    assert rect_normal_quantile(0.0, 2.0) == pytest.approx(2 * 1.959964, rel=1e-5)
+    rng = np.random.default_rng(4)
+    x = rng.uniform(-1, 1, 2_000_000) + rng.normal(0, 0.4, 2_000_000)
+    assert rect_normal_quantile(1.0, 0.4) == pytest.approx(np.quantile(x, 0.975), abs=3e-3)
+    # a dominant rectangular clock term: k near its 1.65 (= 0.95 sqrt 3), not 1.96
+    budget = QuantityBudget("m/s", 0.0, {"clock": Term(1.0, rectangular=True),
+                                         "statistical": Term(0.05, 50.0)})
+    assert budget.k == pytest.approx(1.65, abs=0.01)
+
+
+def test_quantisation_undithered_and_dithered():
+    q = 0.02
+    assert quantisation(q, 0.0) == pytest.approx(q / math.sqrt(12))   # GUM F.2.2.1
+    # input noise of one step: the quantiser's mean error is gone (Widrow): < 1e-8 of q
+    assert quantisation(q, q) < 1e-8 * q
+    # the mean of readings of a constant inside one step errs by up to q/2
+    rng = np.random.default_rng(5)
+    true = rng.uniform(0, 1, 20000) * q
+    errors = np.round(true / q) * q - true
+    assert np.std(errors) == pytest.approx(quantisation(q, 0.0), rel=0.02)
+
+
+def test_resolution_of_quantised_readings():
+    rng = np.random.default_rng(6)
+    x = np.round(rng.normal(50.0, 0.5, 5000) / 0.02) * 0.02
+    assert resolution(x) == pytest.approx(0.02, rel=1e-6)
+    assert resolution(rng.normal(0, 1, 1000)) < 1e-3
+
+
+def test_batch_means_see_a_slow_ripple_and_ignore_telescoping_noise():
+    rng = np.random.default_rng(7)
+    dt, n, tau = 0.02, 2000, 0.7          # 40 s at 50 Hz, AR(1) ripple of 0.7 s
+    phi = math.exp(-dt / tau)
+    means, ses = [], []
+    for _ in range(300):
+        ripple = np.zeros(n)
+        for i in range(1, n):
+            ripple[i] = phi * ripple[i - 1] + rng.normal(0, math.sqrt(1 - phi**2))
+        means.append(ripple.mean())
+        ses.append(batch_means_se(ripple)[0])
+    # true sd of the mean of an AR(1) series: sqrt((1 + phi)/(1 - phi) / n)
+    assert np.std(means) == pytest.approx(math.sqrt((1 + phi) / (1 - phi) / n), rel=0.12)
+    assert np.median(ses) == pytest.approx(np.std(means), rel=0.25)
+    # a rate from positions with white 1 mm noise: its mean telescopes to (x_end - x_0)/T,
+    # sd sqrt(2) 1 mm / T = 3.5e-5 m/s; plain batch means say sqrt(B) = 4.5 times that
+    # (measured 1.65e-4), the lag-1 term brings it to about twice (measured 7e-5; 40 % of
+    # the estimates negative: None, the autocorrelation SE is used then)
+    rates = [np.diff(0.01 * np.arange(n) * dt + 1e-3 * rng.normal(size=n)) / dt
+             for _ in range(100)]
+    plain = [np.std(r[:1980].reshape(20, 99).mean(axis=1), ddof=1) / math.sqrt(20)
+             for r in rates]
+    found = [f[0] for f in map(batch_means_se, rates) if f is not None]
+    assert np.median(plain) == pytest.approx(math.sqrt(20) * math.sqrt(2) * 1e-3 / (n * dt),
+                                             rel=0.1)
+    assert np.median(found) < 0.6 * np.median(plain) and len(found) > 40
+
+def _run(t, angle, dp, fz, load_n):
+    frames = {"/wheel/encoder": pd.DataFrame({"t_s": t, "wheel_angle_rad": angle}),
+              "/tether/force": pd.DataFrame({"t_s": t, "dp_n": dp}),
+              "/hub/wrench": pd.DataFrame({"t_s": t, "fz_n": fz})}
+    return SimpleNamespace(streams=frames, metadata=SimpleNamespace(
+        run=SimpleNamespace(load_n=load_n)))
+
+
+def test_rest_readings_recover_a_linear_zero_drift():
+    """At rest 3 s before and after a 44 s drive the DP cell reads its drift 0.2 + 0.01 t N;
+    the zero at a window of 20-40 s is 0.2 + 0.01 * 30 = 0.5 N."""
+    rng = np.random.default_rng(8)
+    t = np.arange(0.0, 50.0, 0.01)
+    moving = (t > 3.0) & (t < 47.0)
+    angle = np.floor(np.cumsum(np.where(moving, 0.08, 0.0)) * 0.01 / 1e-3) * 1e-3
+    drift = 0.2 + 0.01 * t
+    dp = drift + rng.normal(0, 0.05, t.size) + np.where(moving, 40.0, 0.0)
+    # fz: the wheel carries 180.5 N against a set 180 N, its zero drifting by 0.004 N/s
+    fz = 180.5 + 0.004 * t + rng.normal(0, 0.05, t.size)
+    rests = rest_readings(_run(t, angle, dp, fz, 180.0))
+    assert rests.drive_s[0] == pytest.approx(3.0, abs=0.1)
+    assert rests.drive_s[1] == pytest.approx(47.0, abs=0.1)
+    z = zero_at_window(rests, "dp_n", (20.0, 40.0), 0.0)
+    assert z.zero == pytest.approx(0.5, abs=0.01)
+    assert z.part.change == pytest.approx(0.01 * (48.5 - 1.35), abs=0.01)
+    # only fz's change since the first rest is drift: 0.004 * (30 - 1.35) = 0.115 N, not
+    # the 0.5 N by which the actual load exceeds the set load (that is what fz measures)
+    fz_zero = zero_at_window(rests, "fz_n", (20.0, 40.0), None).zero
+    assert fz_zero == pytest.approx(0.004 * (30.0 - 1.35), abs=0.01)
+    assert zero_at_window(None, "dp_n", (20.0, 40.0), 0.0).part is None
+
+
+def test_pooled_diffusion_of_random_walk_drifts():
+    """Cells drifting as random walks of 0.05 N^2/s: the pooled D^2/T comes back."""
+    rng = np.random.default_rng(9)
+    records = []
+    for _ in range(400):
+        d = rng.normal(0, math.sqrt(0.05 * 45.0))
+        records.append({"before": {"dp_n": {"t_s": 1.5, "mean": 0.0, "se": 0.01}},
+                        "after": {"dp_n": {"t_s": 46.5, "mean": d, "se": 0.01}}})
+    pooled = pooled_diffusion([*records, None])
+    assert pooled["dp_n"].u == pytest.approx(0.05, rel=0.15) and pooled["dp_n"].dof == 400
+
+
+def test_an_unstated_clock_is_said_to_be_assumed():
+    from run_results.uncertainty_budget import DEFAULT_CLOCK_PPM, BudgetParams
+
+    assert BudgetParams().clock_ppm == DEFAULT_CLOCK_PPM and BudgetParams().clock_missing
+    assert BudgetParams(150.0).clock_ppm == 150.0 and BudgetParams(150.0).clock_missing == ()
+    with pytest.raises(ValueError, match="must be >= 0"):
+        BudgetParams(-1.0)
+
+
+def test_phase_sampling_bounds_the_mean_of_a_sharp_wave_seen_m_times_a_period():
+    """A sawtooth (rise 0 -> 1, drop 1) sampled m = 40 times a period: the sample mean errs
+    by up to 1/(2m) (by hand: mean of frac(phi + k/m) = (m-1)/(2m) + phi'); the term is
+    drop/(2m)/sqrt(3) with the drop read from the phase-averaged waveform (20 bins: 0.95)."""
+    from run_results.uncertainty_budget import phase_sampling
+
+    m, f = 40, 0.5
+    t = np.arange(0, 40.0, 1 / (m * f))
+    errors = [np.mod(f * t + phi, 1.0).mean() - 0.5 for phi in np.linspace(0, 1, 97)]
+    assert max(map(abs, errors)) == pytest.approx(1 / (2 * m), rel=0.02)
+    term = phase_sampling(t, np.mod(f * t + 0.3, 1.0), f)
+    assert term.rectangular and term.u == pytest.approx(0.95 / (2 * m) / math.sqrt(3), rel=0.02)
+    assert phase_sampling(t, np.mod(f * t, 1.0), None) is None
+
+
+def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
+    """A flat channel (found by the fuzzer): sigma 1e-14 of a, the quantile is a(2p - 1)."""
+    from run_results.uncertainty_budget import rect_normal_quantile
+
+    assert rect_normal_quantile(1.0, 1e-14) == pytest.approx(0.95, rel=1e-9)
+    assert rect_normal_quantile(1.0, 0.05) == pytest.approx(0.95, abs=0.02)
