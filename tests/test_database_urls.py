@@ -118,7 +118,11 @@ def test_run_ids_of_1000_characters_are_held_longer_or_nul_refused(tmp_path, db_
     assert any(str(too_long) in f and "1001 characters" in f for f in failed)
     assert any(str(with_nul) in f and "NUL" in f for f in failed)
     assert main(["results", "--db", db_url, "--json"]) == 0
-    assert [r["run_id"] for r in json.loads(capsys.readouterr().out)] == [long_id]
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["run_id"] for r in rows if r["status"] != "failed"] == [long_id]
+    # the refused ones are listed as failed under their file names
+    assert sorted(r["run_id"] for r in rows if r["status"] == "failed") == [
+        too_long.stem, with_nul.stem]
 
 
 @pytest.mark.skipif(not os.environ.get("SWTLAB_TEST_POSTGRES_URL"), reason="no PostgreSQL")

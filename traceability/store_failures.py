@@ -11,7 +11,7 @@ from sqlalchemy.orm import Session
 
 from traceability.models import IngestFailure, RawFile, RunResult
 from traceability.store import new_processing_record
-from traceability.text import message
+from traceability.text import TextRefused, checked_name, message
 
 
 def _newest_result_record(session: Session, path: str) -> int | None:
@@ -26,6 +26,10 @@ def store_failure(session: Session, path: Path, sha256: str, stage: str, error_t
     """Record that ``path`` (content ``sha256``) failed at ``stage``; nothing new when its
     newest outcome is already this failure (a rerun of an unchanged bad file)."""
     where, error = str(Path(path).resolve()), message(error)
+    try:
+        run_id = None if run_id is None else checked_name("run_id", run_id)
+    except TextRefused:
+        run_id = None  # the refused run id itself: the file names the failure
     last = session.scalars(select(IngestFailure).filter_by(path=where)
                            .order_by(IngestFailure.processing_id.desc())).first()
     newer_result = _newest_result_record(session, where)
