@@ -135,3 +135,31 @@ def test_postgres_scheme_reads_a_processed_database(tmp_path, db_url, ingest_too
     plain = "postgres://" + db_url.split("://", 1)[1]
     assert main(["results", "--db", plain, "--json"]) == 0
     assert [r["run_id"] for r in json.loads(capsys.readouterr().out)] == ["r001"]
+
+
+def test_an_older_database_holding_runs_is_upgraded_with_them(tmp_path, capsys):
+    """A 0.2.0 database (schema 0007) with a processed run: the batch migrations rebuild
+    tables that others reference, which SQLite refused under its foreign keys ("FOREIGN
+    KEY constraint failed", found on the demo's database of the last release)."""
+    from alembic import command
+    from alembic.config import Config
+
+    from traceability.database import MIGRATIONS
+
+    folder = tmp_path / "c"
+    folder.mkdir()
+    (folder / SAMPLE_RUN.name).write_bytes(SAMPLE_RUN.read_bytes())
+    db = f"sqlite:///{tmp_path / 'old.sqlite'}"
+    assert main(["process", str(folder), "--db", db, "--quiet"]) == 0
+    engine = create_engine(db)  # a plain engine: SQLite's foreign keys off, as at 0.2.0
+    config = Config()
+    config.set_main_option("script_location", str(MIGRATIONS))
+    with engine.begin() as connection:
+        config.attributes["connection"] = connection
+        command.downgrade(config, "0007")
+    engine.dispose()
+    capsys.readouterr()
+    assert main(["migrate", "--db", db]) == 0
+    assert main(["results", "--db", db, "--json"]) == 0
+    (row,) = json.loads(capsys.readouterr().out.split("\n", 1)[1])
+    assert row["run_id"] == SAMPLE_RUN.stem and row["status"] in ("ok", "flagged")

@@ -106,11 +106,28 @@ def head_revision() -> str:
 
 def upgrade(engine: Engine) -> None:
     """Run the Alembic migrations up to head on ``engine`` (under the write lock of an engine
-    opened by :func:`open_database`)."""
+    opened by :func:`open_database`). On SQLite the foreign keys are off while they run: a
+    batch migration rebuilds a table (copy, drop, rename), which a referenced table with
+    rows fails under ``PRAGMA foreign_keys=ON`` (SQLite, "ALTER TABLE": the twelve steps);
+    the keys are checked once the migrations are done."""
     config = _config()
-    with engine.begin() as connection:
-        config.attributes["connection"] = connection
-        command.upgrade(config, "head")
+    sqlite = engine.dialect.name == "sqlite"
+    with engine.connect() as connection:
+        raw = connection.connection.driver_connection
+        if sqlite:  # outside any transaction: the pragma is a no-op inside one
+            raw.execute("PRAGMA foreign_keys=OFF")
+        try:
+            with connection.begin():
+                config.attributes["connection"] = connection
+                command.upgrade(config, "head")
+                broken = (connection.exec_driver_sql("PRAGMA foreign_key_check").fetchall()
+                          if sqlite else [])
+                if broken:
+                    raise RuntimeError(f"the schema upgrade broke {len(broken)} foreign keys "
+                                       f"(first: {broken[0]}); nothing was changed")
+        finally:
+            if sqlite:
+                raw.execute("PRAGMA foreign_keys=ON")
 
 
 def _check_schema(engine: Engine, shown: str) -> None:
