@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ingest.canonical import WRENCH_COLUMNS
-from run_results.native import hub_samples
+from run_results.native import channel_samples, hub_samples
 from stable_phase.signals import grouser_period_s, moving_average
 from swtlab.domain.ranges import METADATA, WHEEL_KEYS
 
@@ -70,11 +70,10 @@ def saturation_flags(run, start_s: float, end_s: float) -> list[str]:
     """Force/torque channels whose window samples pile up at their maximum or minimum."""
     flags = []
     for column in RAIL_CHANNELS:
-        found = _native(run, column)
+        found = channel_samples(run, column, start_s, end_s)
         if found is None:
             continue
-        _, t, y = found
-        y = y[(t >= start_s) & (t <= end_s)]
+        y = found[1]
         if y.size < RAIL_MIN_SAMPLES or np.ptp(y) == 0:
             continue
         levels, counts = np.unique(y, return_counts=True)
@@ -95,11 +94,10 @@ def spike_flags(run, start_s: float, end_s: float) -> list[str]:
     load, radius = run.metadata.run.load_n, run.metadata.wheel.radius_m
     flags = []
     for column in RAIL_CHANNELS:
-        found = _native(run, column)
+        found = channel_samples(run, column, start_s, end_s)
         if found is None:
             continue
-        _, t, y = found
-        y = y[(t >= start_s) & (t <= end_s)]
+        y = found[1]
         scale = SPIKE_LOAD_RATIO * load * (radius if column.endswith("_nm") else 1.0)
         jumps = int(np.sum(np.abs(y - np.median(y)) > scale)) if y.size else 0
         if jumps:
