@@ -66,14 +66,18 @@ def _native(run, column: str):
     return None
 
 
+def _window_samples(run, start_s: float, end_s: float):
+    """``(column, samples in the window)`` of each force/torque channel the run logs."""
+    for column in RAIL_CHANNELS:
+        found = channel_samples(run, column, start_s, end_s)
+        if found is not None:
+            yield column, found[1]
+
+
 def saturation_flags(run, start_s: float, end_s: float) -> list[str]:
     """Force/torque channels whose window samples pile up at their maximum or minimum."""
     flags = []
-    for column in RAIL_CHANNELS:
-        found = channel_samples(run, column, start_s, end_s)
-        if found is None:
-            continue
-        y = found[1]
+    for column, y in _window_samples(run, start_s, end_s):
         if y.size < RAIL_MIN_SAMPLES or np.ptp(y) == 0:
             continue
         levels, counts = np.unique(y, return_counts=True)
@@ -93,11 +97,7 @@ def spike_flags(run, start_s: float, end_s: float) -> list[str]:
     heights (from the arm angle) that jump by more than the wheel radius."""
     load, radius = run.metadata.run.load_n, run.metadata.wheel.radius_m
     flags = []
-    for column in RAIL_CHANNELS:
-        found = channel_samples(run, column, start_s, end_s)
-        if found is None:
-            continue
-        y = found[1]
+    for column, y in _window_samples(run, start_s, end_s):
         scale = SPIKE_LOAD_RATIO * load * (radius if column.endswith("_nm") else 1.0)
         jumps = int(np.sum(np.abs(y - np.median(y)) > scale)) if y.size else 0
         if jumps:
