@@ -128,8 +128,10 @@ def _flags(run, window, oscillation: dict) -> list[str]:
     if window.diagnostics.get("shrunk_to_second_half"):
         flags.append("window shrunk to its second half: the first half drifted (slope test)")
     if window.found and not window.diagnostics.get("r_hat_ok", True):
+        shifts = ", ".join(f"{k} by {v:.3g}" for k, v in window.diagnostics["level_shifts"].items())
         flags.append(f"split-window R statistic {window.diagnostics['r_hat_max']:.3f} above "
-                     f"{window.parameters['r_hat_limit']}")
+                     f"{window.parameters['r_hat_limit']}: the halves' means differ ({shifts}) "
+                     "by more than the practical drift limit")
     expected, measured = oscillation["grouser_expected_hz"], oscillation["grouser_measured_hz"]
     if expected and measured and abs(measured / expected - 1.0) > GROUSER_MISMATCH_RATIO:
         flags.append(f"grouser passing frequency {measured:.4g} Hz differs from n*omega/2pi = "

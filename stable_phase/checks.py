@@ -41,3 +41,14 @@ def split_r_hat(y: np.ndarray) -> float:
     if within <= 0:
         return float("nan")
     return float(np.sqrt(((n - 1) / n * within + between / n) / within))
+
+
+def half_change(y: np.ndarray) -> float:
+    """Mean of the window's second half minus its first half's (the halves of
+    :func:`split_r_hat`): the size of the level shift that a large R statistic detects."""
+    y = np.asarray(y, float)
+    y = y[np.isfinite(y)]
+    n = y.size // 2
+    if n < 4:
+        return float("nan")
+    return float(np.mean(y[-n:]) - np.mean(y[:n]))

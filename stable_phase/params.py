@@ -24,7 +24,8 @@ class StablePhaseParams:
     slope_alpha: float = 0.01             # slope test significance level
     slope_change_force_ratio: float = 0.02   # practical drift limit over the window: 2 % of load
     slope_change_sinkage_ratio: float = 0.05  # ... 5 % of the mean sinkage
-    r_hat_limit: float = 1.1              # split-window potential scale reduction limit
+    r_hat_limit: float = 1.1              # split-window R limit (with a level shift over the
+    #                                       practical drift limit between the halves)
     dig_in_dp_drop_ratio: float = 0.05    # DP falling 5 % of the load after its peak = collapse
 
     def to_dict(self) -> dict:

@@ -7,9 +7,10 @@ import pytest
 from scipy.signal import lfilter
 
 from stable_phase.autocorr import standard_error, statistical_inefficiency
-from stable_phase.checks import slope_test, split_r_hat
+from stable_phase.checks import half_change, slope_test, split_r_hat
 from stable_phase.gate import bridge_dropouts, surface_speed_setpoint_mps
 from stable_phase.mser import mser_two_sided
+from stable_phase.params import StablePhaseParams
 from stable_phase.settling import fit_settling
 from stable_phase.signals import grouser_period_s, longest_true_run, moving_average
 
@@ -78,6 +79,24 @@ def test_slope_test_and_r_hat():
     test = slope_test(t, ramp)
     assert test["p"] < 1e-6 and test["change"] == pytest.approx(6.0, rel=0.1)
     assert split_r_hat(ramp) > 1.5
+    assert half_change(ramp) == pytest.approx(3.0, rel=0.1)  # 0.2/s over half of 30 s
+
+
+def test_r_statistic_flags_only_a_level_shift_over_the_practical_limit():
+    """A quiet signal (a smooth wheel's DP: 0.26 N noise in a 250 N run) shifted by 0.5 N
+    between halves has R well above 1.1, yet moves by a tenth of the 5 N limit (2 % of
+    the load): not flagged. The same R with a 10 N shift on a noisier signal is."""
+    from stable_phase.detect import _check
+
+    t = np.linspace(0, 20, 2000)
+    noise = np.random.default_rng(3).normal(0, 0.26, t.size)
+    step = np.where(t > 10, 1.0, 0.0)
+    params = StablePhaseParams()
+    quiet = _check(t, {"dp_n": 40 + 0.5 * step + noise}, {"dp_n": 5.0}, params)["dp_n"]
+    assert quiet["r_hat"] > 1.1 and quiet["half_change"] == pytest.approx(0.5, abs=0.05)
+    assert not quiet["level_shift"]
+    loud = _check(t, {"dp_n": 40 + 10 * step + 20 * noise}, {"dp_n": 5.0}, params)["dp_n"]
+    assert loud["r_hat"] > 1.1 and loud["level_shift"]
 
 
 def test_set_points_and_grouser_period():
