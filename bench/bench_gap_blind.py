@@ -4,13 +4,15 @@ candidate laws, then again with every law (in family), scored side by side again
 issue's goals (>= 90 % exact on none and singles, >= 70 % on pairs, <= 5 % confident wrong).
 
 ``python -m bench gap_blind`` (N = 40, the full design); ``--quick``: N = 6, the fast
-design. Environment ``GAP_BLIND_N``, ``GAP_BLIND_SEED``, ``GAP_BLIND_FAST=1`` override.
+design. Environment ``GAP_BLIND_N``, ``GAP_BLIND_SEED``, ``GAP_BLIND_FAST=1`` override;
+``GAP_BLIND_SMOOTH=1`` adds the smooth wheel on the same soil (``Design.smooth_wheel``).
 """
 
 from __future__ import annotations
 
 import os
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 from validation.gap_bench import FAST_DESIGN, Design, format_score, rediagnose, run_bench
@@ -33,8 +35,10 @@ def main(quick: bool = False) -> dict:
     n = int(os.environ.get("GAP_BLIND_N", 6 if quick else 40))
     seed = int(os.environ.get("GAP_BLIND_SEED", 11))  # 7, 8: rule set on them
     fast = quick or os.environ.get("GAP_BLIND_FAST") == "1"
-    design = FAST_DESIGN if fast else Design()
-    out = {"n": n, "seed": seed, "design": "fast" if fast else "full"}
+    design = replace(FAST_DESIGN if fast else Design(),
+                     smooth_wheel=os.environ.get("GAP_BLIND_SMOOTH") == "1")
+    out = {"n": n, "seed": seed, "design": "fast" if fast else "full",
+           "smooth_wheel": design.smooth_wheel}
     with tempfile.TemporaryDirectory(prefix="gap-blind-") as tmp:
         workdir = Path(os.environ.get("GAP_BLIND_WORKDIR", tmp))
         for mode in ("held-out", "in-family"):

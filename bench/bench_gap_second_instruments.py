@@ -27,6 +27,7 @@ from validation.gap_bench import FAST_DESIGN, base_model, conditions, diagnose_c
 from validation.gap_bench_second import rig_conditions
 from validation.model_truth import ModelTruth
 from validation.second_rig import Rig, SensorModel, Timeline, write_campaign
+from virtual_testbed.rig import BB2_WHEEL
 
 SEED = 12
 CAMPAIGNS = (1, 6, 7)
@@ -53,7 +54,8 @@ def main(quick: bool = False) -> dict:
         for i in picked:
             for key, rig in rigs.items():
                 name = f"c{i:03d}_{key}"
-                write_campaign(work / name, rig_conditions(conditions(FAST_DESIGN), name),
+                write_campaign(work / name,
+                               rig_conditions(conditions(FAST_DESIGN), name, BB2_WHEEL),
                                ModelTruth(truths[i][0]), SEED * 1000 + i, rig=rig)
                 shutil.rmtree(work / name / "truth")
                 (work / name / "laws.txt").write_text("\n")  # in family: every law

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 from swtlab_cli import exit_codes
@@ -26,6 +27,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--boot", type=int, default=50, help="bootstrap replicates per diagnosis")
     p.add_argument("--fast", action="store_true",
                    help="small campaigns (2 loads x 3 slips x 2 multipass x 2 gravity)")
+    p.add_argument("--smooth-wheel", action="store_true",
+                   help="also run every condition with a smooth wheel of the same size on the "
+                        "same soil and diagnose both wheels together (what separates the "
+                        "soil's slip-sinkage from the lugs')")
     p.add_argument("--truth-laws", choices=("in-family", "held-out"), default="in-family",
                    help="in-family: the diagnosis may use every law of each effect; held-out: "
                         "the law that made each campaign's truth is removed from the laws "
@@ -44,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
     if args.n < 1:
         print("swtlab gap-bench: --n must be >= 1")
         return exit_codes.USAGE
-    design = FAST_DESIGN if args.fast else Design()
+    design = replace(FAST_DESIGN if args.fast else Design(), smooth_wheel=args.smooth_wheel)
     with tempfile.TemporaryDirectory(prefix="gap-bench-") as tmp:
         workdir = args.workdir or Path(tmp)
         try:

@@ -7,6 +7,8 @@ Layout of the work folder::
     c000/campaign/...             raw runs of campaign 0 (all a diagnosis can read)
     c000/laws.txt                 the laws the diagnosis may use (``swtlab gap --laws``)
     c000/swtlab.sqlite            `swtlab process` output
+    c000/smooth/campaign/...      with ``Design.smooth_wheel``: the same conditions run by a
+    c000/smooth.sqlite            smooth wheel of the same size on the same soil
     c000/gap.json                 `swtlab gap` report
     labels/labels.json            hidden effect sets, laws and strengths (only the scorer)
     labels/c000/truth/...         the signal model's per-run truth, moved out of the campaign
@@ -34,7 +36,7 @@ import subprocess
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -80,9 +82,21 @@ class Design:
     multipass: tuple[int, ...] = (0, 1)
     gravity_mps2: tuple[float, ...] = (G0_MPS2, MARS_GRAVITY_MPS2)
     duration_s: float = 60.0
+    #: also run every condition with :data:`SMOOTH_WHEEL` on the same soil, diagnosed as a
+    #: second measured source: the design that tells the soil's slip-sinkage from the lugs'
+    #: (sim_gap.aliasing; Ding et al. 2011 ran a smooth and lugged wheels on one soil)
+    smooth_wheel: bool = False
 
 
 FAST_DESIGN = Design(loads_n=(80.0, 250.0), slips=(0.15, 0.4, 0.65), duration_s=50.0)
+
+
+def smooth_wheel():
+    """The testbed's BB2-like wheel without its grousers (same radius, width, stiffness)."""
+    from virtual_testbed.rig import BB2_WHEEL
+
+    return replace(BB2_WHEEL, name=f"{BB2_WHEEL.name} smooth", grouser_count=0,
+                   grouser_height_m=0.0)
 
 
 def base_model() -> tm.WheelModel:
@@ -148,17 +162,28 @@ def _generate(job) -> None:
     """One campaign's raw runs; its truth folder is moved out of the campaign."""
     from virtual_testbed import Testbed, generate_campaign
 
-    workdir, name, truth, seed, design, signal_model = job
-    out = workdir / name
-    if signal_model == "second":
-        from validation.gap_bench_second import write_second_campaign
+    from virtual_testbed.rig import BB2_WHEEL
 
-        write_second_campaign(out, conditions(design), truth, seed, name, design.duration_s)
-    else:
-        generate_campaign(out, conditions(design), seed=seed, duration_s=design.duration_s,
-                          testbed=Testbed(law=tm.ModelLaw(truth), campaign=name))
-    (workdir / "labels" / name).mkdir(parents=True, exist_ok=True)
-    shutil.move(str(out / "truth"), str(workdir / "labels" / name / "truth"))
+    workdir, name, truth, seed, design, signal_model = job
+    wheels = [("", BB2_WHEEL, truth)]
+    if design.smooth_wheel:
+        smooth = smooth_wheel()
+        wheels.append(("smooth", smooth, truth.with_wheel(grouser_count=0,
+                                                          grouser_height_m=0.0)))
+    for part, wheel, wheel_truth in wheels:
+        out = workdir / name / part
+        if signal_model == "second":
+            from validation.gap_bench_second import write_second_campaign
+
+            write_second_campaign(out, conditions(design), wheel_truth, seed, name,
+                                  design.duration_s, wheel)
+        else:
+            generate_campaign(out, conditions(design), seed=seed, duration_s=design.duration_s,
+                              testbed=Testbed(law=tm.ModelLaw(wheel_truth), campaign=name,
+                                              wheel=wheel))
+        labels = workdir / "labels" / name / part
+        labels.mkdir(parents=True, exist_ok=True)
+        shutil.move(str(out / "truth"), str(labels / "truth"))
 
 
 def laws_option(laws: dict[str, tuple[str, ...]] | None) -> str:
@@ -196,13 +221,18 @@ def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True)
     ``swtlab gap`` in separate processes that are given the raw campaign folder, the
     database, the simulation and the laws they may use only. Returns the seconds taken."""
     start = time.perf_counter()
-    db = f"sqlite:///{workdir / name / 'swtlab.sqlite'}"
+    dbs = [(workdir / name / "campaign", f"sqlite:///{workdir / name / 'swtlab.sqlite'}")]
+    if (workdir / name / "smooth" / "campaign").is_dir():
+        dbs.append((workdir / name / "smooth" / "campaign",
+                    f"sqlite:///{workdir / name / 'smooth.sqlite'}"))
     cli = [sys.executable, "-m", "swtlab_cli.main"]
     if process:
-        subprocess.run(cli + ["process", str(workdir / name / "campaign"), "--db", db,
-                              "--quiet"], check=True, capture_output=True)
+        for folder, db in dbs:
+            subprocess.run(cli + ["process", str(folder), "--db", db, "--quiet"], check=True,
+                           capture_output=True)
     laws = (workdir / name / "laws.txt").read_text().strip()
-    subprocess.run(cli + ["gap", "--measured", db, "--sim", str(workdir / "sim.toml"),
+    measured = [arg for _, db in dbs for arg in ("--measured", db)]
+    subprocess.run(cli + ["gap", *measured, "--sim", str(workdir / "sim.toml"),
                           "--json", str(workdir / name / "gap.json"), "--boot", str(boot)]
                    + (["--laws", laws] if laws else []), check=True, capture_output=True)
     return time.perf_counter() - start

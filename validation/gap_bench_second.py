@@ -18,12 +18,10 @@ from validation.model_truth import ModelTruth
 from validation.second_rig import Rig, RunCondition, Timeline, WheelGeometry, write_campaign
 
 
-def rig_conditions(conds, campaign: str) -> list[RunCondition]:
+def rig_conditions(conds, campaign: str, w) -> list[RunCondition]:
     """Speed-control conditions of the virtual testbed (gap_bench's ``conditions``) as
-    second-rig conditions, on the virtual testbed's wheel."""
-    from virtual_testbed.rig import BB2_WHEEL
-
-    w = BB2_WHEEL
+    second-rig conditions, on the virtual testbed's wheel ``w`` (a ``swtlab.domain.Wheel``
+    with its stiffness)."""
     wheel = WheelGeometry(name=w.name, radius_m=w.radius_m, width_m=w.width_m,
                           grouser_count=w.grouser_count, grouser_height_m=w.grouser_height_m,
                           stiffness_n_per_mm=w.stiffness_n_per_mm)
@@ -34,8 +32,8 @@ def rig_conditions(conds, campaign: str) -> list[RunCondition]:
 
 
 def write_second_campaign(out: Path, conds, truth: tm.WheelModel, seed: int, name: str,
-                          duration_s: float) -> None:
-    """One campaign's raw runs from the second rig under ``out/campaign``, the truth of
-    ``truth``'s curves under ``out/truth`` (as the testbed's ``generate_campaign``)."""
+                          duration_s: float, wheel) -> None:
+    """One campaign's raw runs of ``wheel`` from the second rig under ``out/campaign``, the
+    truth of ``truth``'s curves under ``out/truth`` (as the testbed's ``generate_campaign``)."""
     rig = Rig(timeline=Timeline(duration_s=duration_s))
-    write_campaign(out, rig_conditions(conds, name), ModelTruth(truth), seed, rig=rig)
+    write_campaign(out, rig_conditions(conds, name, wheel), ModelTruth(truth), seed, rig=rig)
