@@ -25,10 +25,20 @@ def quantities_of(points: pd.DataFrame) -> list[str]:
 
 
 def sigmas(points: pd.DataFrame, radius_m: float) -> dict[str, np.ndarray]:
-    """Per-point uncertainty of each quantity for fitting: SE and the floor in quadrature."""
+    """Per-point uncertainty of each quantity for fitting. Where the point's source measured
+    its run-to-run repeatability (``<q>_repeat_sd``: replicate runs, or the spread of a
+    points CSV row's repeats), the larger of the point's own uncertainty ``<q>_se`` (its
+    GUM budget, or SE) and that repeatability; elsewhere ``<q>_se`` and the assumed
+    repeatability :func:`~sim_gap.vocabulary.model_error_floor` in quadrature."""
     load = points["wheel_load_n"].to_numpy(float)
-    return {q: np.hypot(points[f"{q}_se"].to_numpy(float), model_error_floor(q, load, radius_m))
-            for q in quantities_of(points)}
+    out = {}
+    for q in quantities_of(points):
+        se = points[f"{q}_se"].to_numpy(float)
+        repeat = (points[f"{q}_repeat_sd"].to_numpy(float) if f"{q}_repeat_sd" in points
+                  else np.full(se.shape, np.nan))
+        assumed = np.hypot(se, model_error_floor(q, load, radius_m))
+        out[q] = np.where(np.isfinite(repeat), np.fmax(se, repeat), assumed)
+    return out
 
 
 def standardised_residuals(points: pd.DataFrame, predicted: dict[str, np.ndarray],

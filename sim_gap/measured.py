@@ -5,7 +5,9 @@ Columns: ``run_id``, ``source`` (the campaign or curve set the row comes from), 
 its source (``wheel_radius_m``, ``wheel_width_m``, ``grouser_count``, ``grouser_height_m``),
 ``load_set_n`` (set load: grouping), ``wheel_load_n`` (measured wheel load, used in the
 model), ``multipass``, ``gravity_mps2``, ``slip`` and ``<q>``, ``<q>_se`` for the
-quantities of :data:`sim_gap.vocabulary.QUANTITIES` that the source has. ``attrs``:
+quantities of :data:`sim_gap.vocabulary.QUANTITIES` that the source has, and
+``<q>_repeat_sd`` where the source measured its repeatability (:func:`sim_gap.fit.sigmas`).
+``attrs``:
 ``source`` (text), ``wheels`` (source -> its :class:`swtlab.domain.Wheel`), ``wheel`` (the
 one measured wheel, None when the sources have several), ``sinkage_relative`` (True when
 only sinkage differences are known, e.g. a hub height without an absolute zero).
@@ -23,6 +25,7 @@ from fitting.table import from_run_results
 from sim_gap.points_csv import WHEEL_KEY, is_points_csv, read_points_csv, wheel_of
 from sim_gap.vocabulary import QUANTITIES
 from swtlab.domain import G0_MPS2, Wheel, check_results, wheels_of
+from swtlab.domain.replicates import replicate_spread
 from wpm_export import WheelPerformanceModule
 
 #: the wheel of the CMU smooth runs: the shipped channel map's swt.wheel
@@ -40,7 +43,7 @@ def _finish(table: pd.DataFrame, source: str, wheel: Wheel,
             "gravity_mps2", "slip"]
     for q in QUANTITIES:
         if q in table and table[q].notna().any():
-            cols += [q, f"{q}_se"]
+            cols += [q, f"{q}_se"] + ([f"{q}_repeat_sd"] if f"{q}_repeat_sd" in table else [])
     out = table[cols].reset_index(drop=True)
     out["multipass"] = out["multipass"].astype(int)
     out.attrs.update(source=source, wheel=wheel, wheels={source: wheel},
@@ -96,6 +99,7 @@ def from_results_table(results: pd.DataFrame, source: str = "results") -> pd.Dat
     status ``ok``, speed control, free sled or towed; docs/results.md). A run without a
     measured load is modelled at its set load."""
     table = from_run_results(check_results(results)) if len(results) else results
+    table = table.assign(**pooled_repeatability(results)) if len(table) else table
     table = table.dropna(subset=["slip"]) if len(table) else table
     if table.empty:
         raise ValueError(f"{source}: no processed run with status ok")
@@ -104,6 +108,19 @@ def from_results_table(results: pd.DataFrame, source: str = "results") -> pd.Dat
     table = table.assign(load_set_n=set_load,
                          wheel_load_n=measured.astype(float).fillna(set_load))
     return _finish(table, source, _one_wheel(wheels_of(table), source))
+
+
+def pooled_repeatability(results: pd.DataFrame) -> dict[str, float]:
+    """``<q>_repeat_sd``: the pooled standard deviation of the replicate runs of
+    ``results`` per quantity, ``sqrt(sum (n_i - 1) s_i^2 / sum (n_i - 1))`` over its
+    conditions with replicates (ISO 5725-2 repeatability); none without replicates."""
+    spread = replicate_spread(results, QUANTITIES)
+    out = {}
+    for q, rows in spread.groupby("quantity") if len(spread) else ():
+        dof = rows["runs"].to_numpy(float) - 1.0
+        out[f"{q}_repeat_sd"] = float(np.sqrt(np.sum(dof * rows["replicate_sd"] ** 2)
+                                              / np.sum(dof)))
+    return out
 
 
 def from_database(url: str) -> pd.DataFrame:

@@ -166,6 +166,8 @@ def _row(path: str, number: int, header: list[str], raw: str, quantities: list[s
         value = _number(cell[spread], where(spread), 0.0)
         if spread.endswith("_sd") and row["n_repeats"]:
             value /= math.sqrt(row["n_repeats"])
+            if row["n_repeats"] >= 2:  # the spread of repeats: measured repeatability
+                row[f"{q}_repeat_sd"] = value
         row[f"{q}_se"] = value
         measured = True
     if not measured:

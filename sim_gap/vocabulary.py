@@ -26,10 +26,10 @@ def slip_band(slip: np.ndarray) -> np.ndarray:
 
 
 def model_error_floor(quantity: str, load_n: np.ndarray, radius_m: float) -> np.ndarray:
-    """Uncertainty floor added in quadrature to a measurement's SE when fitting: 1 % of the
-    wheel load for forces (torque: times the radius), 0.3 mm for sinkage. It stands for the
-    run-to-run repeatability of an SWT (soil preparation, transients) that the stable-phase
-    SE of one run does not contain."""
+    """Assumed run-to-run repeatability, added in quadrature to a measurement's own
+    uncertainty when fitting where the source did not measure it (no replicates): 1 % of
+    the wheel load for forces (torque: times the radius), 0.3 mm for sinkage; soil
+    preparation and transients that one run's uncertainty budget does not contain."""
     load_n = np.asarray(load_n, dtype=float)
     if quantity == "sinkage_m":
         return np.full(load_n.shape, 3e-4)
