@@ -133,6 +133,87 @@ def branch_terms(curve: PowerCurve) -> int:
     return 2 if curve.slope_below_zero else 1 if curve.step_below_zero else 0
 
 
+@dataclass(frozen=True)
+class _Setup:
+    """What an interpolation across load of one quantity's tested curves needs: the curves
+    by load, the shared slip range, the result's degree, the method, the slip grid, the
+    projection (grid values -> solution) and the tested curves' values on the grid."""
+
+    tested: np.ndarray
+    ordered: list
+    slip_min: float
+    slip_max: float
+    degree: int
+    method: str
+    grid: np.ndarray
+    projection: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, curves: Mapping[float, PowerCurve], method: str, degree: int | None,
+           grid_points: int) -> _Setup:
+        if method not in METHODS:
+            raise ValueError(f"method {method!r}: one of {METHODS}")
+        tested = np.array(sorted(float(k) for k in curves))
+        if tested.size == 0:
+            raise LoadRangeError("no tested loads to interpolate from")
+        ordered = [curves[k] for k in sorted(curves, key=float)]
+        lo, hi = max(c.slip_min for c in ordered), min(c.slip_max for c in ordered)
+        if lo >= hi:
+            raise LoadRangeError(f"the tested loads {tested.tolist()} share no slip range")
+        degree = max(c.degree for c in ordered) if degree is None else degree
+        if degree not in DEGREES:
+            raise DegreeError(f"degree {degree!r} outside 3-7")
+        method = ("pchip" if tested.size >= 3 else "linear") if method == "auto" else method
+        branch = max(branch_terms(c) for c in ordered) if lo < 0 else 0
+        grid, projection = _projection(lo, hi, degree, grid_points, branch)
+        values = np.array([curve_value(c.coefficients, grid, c.step_below_zero,
+                                       c.slope_below_zero) for c in ordered])
+        return cls(tested, ordered, lo, hi, degree, method, grid, projection, values)
+
+
+class LoadPolynomial:
+    """The interpolated curves' parameters ``(a_0 ... a_n, J, K)`` as an exact polynomial of
+    load per interval between tested loads: across load the grid values are PCHIP (or linear)
+    pieces, cubic in load at each slip, and the refit is linear, so each piece's four
+    coefficient vectors are projected once (the same curves as :func:`interpolate_loads`,
+    to rounding, at any number of loads for a few multiply-adds each). Extrapolation:
+    linear from the two nearest tested loads, as there."""
+
+    def __init__(self, curves: Mapping[float, PowerCurve], method: str = "auto",
+                 degree: int | None = None, grid_points: int = GRID_POINTS) -> None:
+        setup = _Setup.of(curves, method, degree, grid_points)
+        self.tested, self.method, self.degree = setup.tested, setup.method, setup.degree
+        self.slip_min, self.slip_max = setup.slip_min, setup.slip_max
+        to_theta = setup.projection @ solution_to_parameters(
+            setup.slip_min, setup.slip_max, setup.degree, setup.projection.shape[1])
+        self._at_tested = setup.values @ to_theta  # tested loads x p
+        if setup.tested.size >= 2 and setup.method == "pchip":
+            pieces = PchipInterpolator(setup.tested, setup.values, axis=0).c  # 4 x L-1 x grid
+            self._pieces = pieces @ to_theta  # 4 x L-1 x p: cubic in (load - tested[k])
+        else:
+            self._pieces = None
+
+    def parameters(self, loads_n, allow_extrapolation: bool = False
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """(parameters, loads x p; extrapolated mask) at ``loads_n`` (raises
+        :class:`LoadRangeError` as :func:`interpolate_loads`)."""
+        query = np.atleast_1d(np.asarray(loads_n, dtype=float)).ravel()
+        outside = _check_loads(self.tested, query, allow_extrapolation)
+        tested, at = self.tested, self._at_tested
+        if tested.size == 1:
+            return np.repeat(at, query.size, axis=0), outside
+        hi = np.clip(np.searchsorted(tested, query), 1, tested.size - 1)
+        t = ((query - tested[hi - 1]) / (tested[hi] - tested[hi - 1]))[:, None]
+        out = (1.0 - t) * at[hi - 1] + t * at[hi]
+        if self._pieces is not None and np.any(~outside):
+            k = hi[~outside] - 1
+            dx = (query[~outside] - tested[k])[:, None]
+            c = self._pieces[:, k]
+            out[~outside] = ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]
+        return out, outside
+
+
 def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: str = "auto",
                       degree: int | None = None, allow_extrapolation: bool = False,
                       grid_points: int = GRID_POINTS, uncertainty: bool = True) -> LoadCurves:
@@ -142,24 +223,13 @@ def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: st
     every one has it.
     Raises :class:`LoadRangeError` (load outside the tested ones without
     ``allow_extrapolation``, no common slip range) or :class:`DegreeError`."""
-    if method not in METHODS:
-        raise ValueError(f"method {method!r}: one of {METHODS}")
-    tested = np.array(sorted(float(k) for k in curves))
     query = np.atleast_1d(np.asarray(loads_n, dtype=float)).ravel()
+    setup = _Setup.of(curves, method, degree, grid_points)
+    tested, ordered, lo, hi, degree, method = (setup.tested, setup.ordered, setup.slip_min,
+                                               setup.slip_max, setup.degree, setup.method)
     outside = _check_loads(tested, query, allow_extrapolation)
-    ordered = [curves[k] for k in sorted(curves, key=float)]
-    lo, hi = max(c.slip_min for c in ordered), min(c.slip_max for c in ordered)
-    if lo >= hi:
-        raise LoadRangeError(f"the tested loads {tested.tolist()} share no slip range")
-    degree = max(c.degree for c in ordered) if degree is None else degree
-    if degree not in DEGREES:
-        raise DegreeError(f"degree {degree!r} outside 3-7")
-    method = ("pchip" if tested.size >= 3 else "linear") if method == "auto" else method
-    branch = max(branch_terms(c) for c in ordered) if lo < 0 else 0
-    grid, projection = _projection(lo, hi, degree, grid_points, branch)
-    values = _across_load(tested, np.array([curve_value(c.coefficients, grid, c.step_below_zero,
-                                                        c.slope_below_zero) for c in ordered]),
-                          query, method, outside)
+    grid, projection = setup.grid, setup.projection
+    values = _across_load(tested, setup.values, query, method, outside)
     coefficients, below = branch_from_solution(values @ projection, lo, hi, degree)
     misfit = curve_value(coefficients[:, None, :], grid, below[:, :1], below[:, 1:]) - values
     known = uncertainty and all(c.covariance is not None for c in ordered)
