@@ -162,11 +162,12 @@ class InverseTable:
 
     def solve_many(self, targets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(slip, value, status)`` arrays of many targets."""
-        t = np.asarray(targets, dtype=float)
+        shape = np.shape(targets)
+        t = np.asarray(targets, dtype=float).reshape(-1)
         slip = np.interp(t, self.values, self.slips)
-        above, below = t > self.top, t < self.bottom
-        value = np.where(above, self.top, np.where(below, self.bottom, t))
+        value = np.clip(t, self.bottom, self.top)
         status = np.full(t.shape, STATUS_OK, dtype="<U9")
+        above, below = t > self.top, t < self.bottom
         if above.any():
             slip[above], status[above] = 1.0, STATUS_ABOVE
         if below.any():
@@ -174,4 +175,4 @@ class InverseTable:
         if self.step is not None:
             jump = (t > self.step[0]) & (t < self.step[1])
             slip[jump], status[jump] = 0.0, STATUS_STEP
-        return slip, value, status
+        return slip.reshape(shape), value.reshape(shape), status.reshape(shape)

@@ -49,6 +49,7 @@ class WheelPerformanceModule:
         self._polynomials: dict[tuple, LoadPolynomial] = {}
         self._tables: dict[tuple, tuple[InverseTable, InterpolatedCurve]] = {}
         self._seen: set[tuple] = set()
+        self._fast: dict[tuple, tuple[InverseTable, InterpolatedCurve]] = {}
         for c in curves:
             by_quantity = self._sets.setdefault((c.soil, c.wheel, c.multipass), {})
             by_quantity.setdefault(c.quantity, {})[c.load_n] = c
@@ -86,8 +87,9 @@ class WheelPerformanceModule:
         the choices."""
         match = [k for k in self.sets() if (soil is None or k[0] == soil)
                  and (wheel is None or k[1] == wheel) and (multipass is None or k[2] == multipass)]
-        choices = "; ".join(f"--soil {s} --wheel {w} --multipass {m}" for s, w, m in self.sets())
         if not match:
+            choices = "; ".join(f"--soil {s} --wheel {w} --multipass {m}"
+                                for s, w, m in self.sets())
             raise WpmSelectionError(f"no curves for soil={soil} wheel={wheel} "
                                     f"multipass={multipass} in {self.source}; choices: {choices}")
         if len(match) > 1:
@@ -175,10 +177,13 @@ class WheelPerformanceModule:
         """:meth:`slip_for` of one target at one load as ``(slip, value, status)`` floats and
         text: the call a simulator makes in its loop (the load's table is built the second
         time the load is asked for, then every call is a table look-up)."""
+        fast = self._fast.get((quantity, soil, wheel, multipass, load_n))
+        if fast is not None and not fast[1].extrapolated and target - target == 0.0:
+            return fast[0].solve(target)
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
         key, polynomial = self._polynomial(quantity, selection)
         load_n, target = float(load_n), float(target)
-        if target != target or target in (float("inf"), float("-inf")):
+        if target - target != 0.0:
             raise ValueError("targets must be finite numbers")
         seen = (key, load_n) in self._seen
         entry = self._table(key, quantity, load_n, selection, allow_extrapolation, seen)
@@ -186,6 +191,9 @@ class WheelPerformanceModule:
             self._seen.add((key, load_n))
             found = self._rows(polynomial, [target], [load_n], allow_extrapolation)
             return float(found.slip[0]), float(found.value[0]), str(found.status[0])
+        if len(self._fast) >= MAX_TABLES:
+            del self._fast[next(iter(self._fast))]
+        self._fast[(quantity, soil, wheel, multipass, load_n)] = entry
         return entry[0].solve(target)
 
     @staticmethod
@@ -205,11 +213,19 @@ class WheelPerformanceModule:
         falls inside the jump at zero slip (:mod:`wpm_export.inverse`); ``value`` is the
         target where it is reached. Exact to 1e-8 in slip (tables) or rounding (rows)."""
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
+        key, polynomial = self._polynomial(quantity, selection)
+        if np.ndim(load_n) == 0:  # one load: its table
+            target = np.asarray(target, dtype=float)
+            if not np.isfinite(target).all():
+                raise ValueError("targets must be finite numbers")
+            table, _ = self._table(key, quantity, float(load_n), selection,
+                                   allow_extrapolation, True)
+            slip, value, status = table.solve_many(target)
+            return SlipSolution(slip=slip, value=value, status=status)
         target, load = np.broadcast_arrays(np.asarray(target, dtype=float),
                                            np.asarray(load_n, dtype=float))
         if not np.all(np.isfinite(target)):
             raise ValueError("targets must be finite numbers")
-        key, polynomial = self._polynomial(quantity, selection)
         shape, target, load = target.shape, target.ravel(), load.ravel()
         unique = np.unique(load)
         if unique.size > TABLE_LOADS:
