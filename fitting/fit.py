@@ -16,6 +16,7 @@ way), with step and slope by 0.67 % and 0.69 % (docs/fitting.md, "The join at ze
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import chi2
 from scipy.stats import t as student_t
 
 from fitting.curve import DEGREES, QUANTITY_UNITS, CurveFit
@@ -163,15 +164,16 @@ def _branch_se(ls, resid: np.ndarray, weights: np.ndarray, from_se: bool) -> tup
 def fit_uncertainty(ls, resid: np.ndarray, weights: np.ndarray, from_se: bool
                     ) -> tuple[tuple[tuple[float, ...], ...], float, float]:
     """(covariance of ``(a_0 ... a_n, J, K)``, run-to-run SD, 95 % factor) of a fit
-    (docs/fitting.md, "Bands"). With weights 1/sigma^2: ``(X^T W X)^-1`` times the Birge
-    ratio ``max(1, chi^2/dof)`` (Birge 1932, Phys. Rev. 40:207; the Particle Data Group's
-    scale factor), scatter the RMS sigma times its root, factor 1.96 when the ratio is <= 1
-    (the sigmas are trusted) else Student's t(0.975, dof). Without sigmas: scaled by
-    ``WRSS/dof``, scatter its root, factor t(0.975, dof)."""
+    (docs/fitting.md, "Bands"). With weights 1/sigma^2: ``(X^T W X)^-1``, scatter the RMS
+    sigma, factor 1.96, while chi^2 = WRSS is consistent with the sigmas (below its 95 %
+    quantile for dof); else all scaled by the Birge ratio ``chi^2/dof`` (Birge 1932,
+    Phys. Rev. 40:207; the Particle Data Group's scale factor) with factor Student's
+    t(0.975, dof). Without sigmas: scaled by ``WRSS/dof``, scatter its root, factor t."""
     dof = resid.size - ls.n_parameters
-    ratio = float(np.sum(weights * resid ** 2)) / dof if dof > 0 else float("nan")
+    wrss = float(np.sum(weights * resid ** 2))
+    ratio = wrss / dof if dof > 0 else float("nan")
     if from_se:
-        trusted = not ratio > 1.0  # NaN (no dof): the sigmas alone
+        trusted = not dof > 0 or wrss <= float(chi2.ppf(0.95, dof))
         scale = 1.0 if trusted else ratio
         scatter = float(np.sqrt(scale * np.mean(1.0 / weights)))
     else:
