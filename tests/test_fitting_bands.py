@@ -53,7 +53,8 @@ def _summary(fits_by_seed, truth, held_out) -> pd.DataFrame:
             rows[f.quantity]["pred"] += _inside_prediction(f, at["slip"], at[f.quantity])
         for (_, _, _, q), curves in curves_by_load(fits).items():
             curve = interpolate_load(curves, 120.0)
-            rows[q]["conf_120"].append(_grid_coverage(curve, lambda s: truth(120.0, s)[q]))
+            rows[q]["conf_120"].append(_grid_coverage(curve,
+                                                      lambda s, q=q: truth(120.0, s)[q]))
             at = new[np.isclose(new["load_n"], 120.0)]
             rows[q]["pred"] += _inside_prediction(curve, at["slip"], at[q])
     return pd.DataFrame({q: {k: float(np.mean(v)) for k, v in r.items()} | {
