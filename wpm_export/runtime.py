@@ -110,20 +110,23 @@ class WheelPerformanceModule:
                                     + ", ".join(self.quantities(**selection)))
         return self._sets[key][quantity]
 
-    def _curves_at(self, quantity: str, loads_n, selection: dict,
-                   allow_extrapolation: bool) -> tuple[LoadCurves, np.ndarray]:
-        """Curves at the distinct loads of ``loads_n`` and the index of each load's curve."""
+    def _curves_at(self, quantity: str, loads_n, selection: dict, allow_extrapolation: bool,
+                   uncertainty: bool = False) -> tuple[LoadCurves, np.ndarray]:
+        """Curves at the distinct loads of ``loads_n`` and the index of each load's curve
+        (with their covariance only when ``uncertainty``: it costs per load)."""
         unique, inverse = np.unique(np.asarray(loads_n, dtype=float).ravel(), return_inverse=True)
         curves = interpolate_loads(self._by_load(quantity, selection), unique,
                                    method=self.load_method,
-                                   allow_extrapolation=allow_extrapolation)
+                                   allow_extrapolation=allow_extrapolation,
+                                   uncertainty=uncertainty)
         return curves, inverse
 
     def curve(self, quantity: str, load_n: float, *, soil=None, wheel=None, multipass=None,
               allow_extrapolation: bool = False) -> InterpolatedCurve:
-        """The ``quantity`` curve at ``load_n`` (N)."""
+        """The ``quantity`` curve at ``load_n`` (N), with its bands (:func:`fitting.band`)."""
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
-        return self._curves_at(quantity, [load_n], selection, allow_extrapolation)[0].curve(0)
+        return self._curves_at(quantity, [load_n], selection, allow_extrapolation,
+                               uncertainty=True)[0].curve(0)
 
     def at_slip(self, slip, load_n, *, soil=None, wheel=None, multipass=None,
                 allow_extrapolation: bool = False) -> dict[str, np.ndarray]:
