@@ -28,7 +28,8 @@ from scipy.interpolate import PchipInterpolator
 
 from fitting.curve import DEGREES, PowerCurve
 from fitting.errors import DegreeError, LoadExtrapolationWarning, LoadRangeError
-from fitting.polynomial import branch_design, branch_from_solution, curve_value, lobatto_grid
+from fitting.polynomial import (branch_design, branch_from_solution, curve_value, lobatto_grid,
+                                parameter_gradient, solution_to_parameters)
 
 GRID_POINTS = 101
 METHODS = ("auto", "linear", "pchip")
@@ -38,7 +39,8 @@ METHODS = ("auto", "linear", "pchip")
 class InterpolatedCurve(PowerCurve):
     """The curve at ``load_n``; ``fit_rmse`` is the RMS misfit of its polynomial to the
     interpolated grid values (0 to rounding for linear interpolation: a weighted sum of
-    polynomials is one)."""
+    polynomials is one). Its covariance is the tested curves' propagated through the
+    interpolation, its ``scatter_sd`` and ``k95`` linear across load between theirs."""
 
     load_n: float
     method: str
@@ -64,6 +66,9 @@ class LoadCurves:
     tested_loads_n: tuple[float, ...]
     extrapolated: np.ndarray
     fit_rmse: np.ndarray
+    covariance: np.ndarray | None = None
+    scatter_sd: np.ndarray | None = None
+    k95: np.ndarray | None = None
 
     def curve(self, i: int) -> InterpolatedCurve:
         return InterpolatedCurve(
@@ -72,7 +77,11 @@ class LoadCurves:
             slope_below_zero=float(self.below_zero[i, 1]), load_n=float(self.loads_n[i]),
             method=self.method,
             tested_loads_n=self.tested_loads_n, extrapolated=bool(self.extrapolated[i]),
-            fit_rmse=float(self.fit_rmse[i]))
+            fit_rmse=float(self.fit_rmse[i]),
+            covariance=None if self.covariance is None
+            else tuple(tuple(float(v) for v in row) for row in self.covariance[i]),
+            scatter_sd=float("nan") if self.scatter_sd is None else float(self.scatter_sd[i]),
+            k95=float("nan") if self.k95 is None else float(self.k95[i]))
 
 
 def _check_loads(tested: np.ndarray, query: np.ndarray, allow_extrapolation: bool) -> np.ndarray:
@@ -124,37 +133,145 @@ def branch_terms(curve: PowerCurve) -> int:
     return 2 if curve.slope_below_zero else 1 if curve.step_below_zero else 0
 
 
+@dataclass(frozen=True)
+class _Setup:
+    """What an interpolation across load of one quantity's tested curves needs: the curves
+    by load, the shared slip range, the result's degree, the method, the slip grid, the
+    projection (grid values -> solution) and the tested curves' values on the grid."""
+
+    tested: np.ndarray
+    ordered: list
+    slip_min: float
+    slip_max: float
+    degree: int
+    method: str
+    grid: np.ndarray
+    projection: np.ndarray
+    values: np.ndarray
+
+    @classmethod
+    def of(cls, curves: Mapping[float, PowerCurve], method: str, degree: int | None,
+           grid_points: int) -> _Setup:
+        if method not in METHODS:
+            raise ValueError(f"method {method!r}: one of {METHODS}")
+        tested = np.array(sorted(float(k) for k in curves))
+        if tested.size == 0:
+            raise LoadRangeError("no tested loads to interpolate from")
+        ordered = [curves[k] for k in sorted(curves, key=float)]
+        lo, hi = max(c.slip_min for c in ordered), min(c.slip_max for c in ordered)
+        if lo >= hi:
+            raise LoadRangeError(f"the tested loads {tested.tolist()} share no slip range")
+        degree = max(c.degree for c in ordered) if degree is None else degree
+        if degree not in DEGREES:
+            raise DegreeError(f"degree {degree!r} outside 3-7")
+        method = ("pchip" if tested.size >= 3 else "linear") if method == "auto" else method
+        branch = max(branch_terms(c) for c in ordered) if lo < 0 else 0
+        grid, projection = _projection(lo, hi, degree, grid_points, branch)
+        values = np.array([curve_value(c.coefficients, grid, c.step_below_zero,
+                                       c.slope_below_zero) for c in ordered])
+        return cls(tested, ordered, lo, hi, degree, method, grid, projection, values)
+
+
+class LoadPolynomial:
+    """The interpolated curves' parameters ``(a_0 ... a_n, J, K)`` as an exact polynomial of
+    load per interval between tested loads: across load the grid values are PCHIP (or linear)
+    pieces, cubic in load at each slip, and the refit is linear, so each piece's four
+    coefficient vectors are projected once (the same curves as :func:`interpolate_loads`,
+    to rounding, at any number of loads for a few multiply-adds each). Extrapolation:
+    linear from the two nearest tested loads, as there."""
+
+    def __init__(self, curves: Mapping[float, PowerCurve], method: str = "auto",
+                 degree: int | None = None, grid_points: int = GRID_POINTS) -> None:
+        setup = _Setup.of(curves, method, degree, grid_points)
+        self.tested, self.method, self.degree = setup.tested, setup.method, setup.degree
+        self.slip_min, self.slip_max = setup.slip_min, setup.slip_max
+        to_theta = setup.projection @ solution_to_parameters(
+            setup.slip_min, setup.slip_max, setup.degree, setup.projection.shape[1])
+        self._at_tested = setup.values @ to_theta  # tested loads x p
+        if setup.tested.size >= 2 and setup.method == "pchip":
+            pieces = PchipInterpolator(setup.tested, setup.values, axis=0).c  # 4 x L-1 x grid
+            self._pieces = pieces @ to_theta  # 4 x L-1 x p: cubic in (load - tested[k])
+        else:
+            self._pieces = None
+
+    def parameters(self, loads_n, allow_extrapolation: bool = False
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """(parameters, loads x p; extrapolated mask) at ``loads_n`` (raises
+        :class:`LoadRangeError` as :func:`interpolate_loads`)."""
+        query = np.atleast_1d(np.asarray(loads_n, dtype=float)).ravel()
+        outside = _check_loads(self.tested, query, allow_extrapolation)
+        tested, at = self.tested, self._at_tested
+        if tested.size == 1:
+            return np.repeat(at, query.size, axis=0), outside
+        hi = np.clip(np.searchsorted(tested, query), 1, tested.size - 1)
+        t = ((query - tested[hi - 1]) / (tested[hi] - tested[hi - 1]))[:, None]
+        out = (1.0 - t) * at[hi - 1] + t * at[hi]
+        if self._pieces is not None and np.any(~outside):
+            k = hi[~outside] - 1
+            dx = (query[~outside] - tested[k])[:, None]
+            c = self._pieces[:, k]
+            out[~outside] = ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]
+        return out, outside
+
+
 def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: str = "auto",
                       degree: int | None = None, allow_extrapolation: bool = False,
-                      grid_points: int = GRID_POINTS) -> LoadCurves:
+                      grid_points: int = GRID_POINTS, uncertainty: bool = True) -> LoadCurves:
     """Curves at every load of ``loads_n`` from ``curves`` (tested load in N -> curve of one
     quantity). ``degree``: of the fitted result, default the highest tested degree.
+    ``uncertainty``: carry the tested curves' covariance through (:func:`_propagate`) when
+    every one has it.
     Raises :class:`LoadRangeError` (load outside the tested ones without
     ``allow_extrapolation``, no common slip range) or :class:`DegreeError`."""
-    if method not in METHODS:
-        raise ValueError(f"method {method!r}: one of {METHODS}")
-    tested = np.array(sorted(float(k) for k in curves))
     query = np.atleast_1d(np.asarray(loads_n, dtype=float)).ravel()
+    setup = _Setup.of(curves, method, degree, grid_points)
+    tested, ordered, lo, hi, degree, method = (setup.tested, setup.ordered, setup.slip_min,
+                                               setup.slip_max, setup.degree, setup.method)
     outside = _check_loads(tested, query, allow_extrapolation)
-    ordered = [curves[k] for k in sorted(curves, key=float)]
-    lo, hi = max(c.slip_min for c in ordered), min(c.slip_max for c in ordered)
-    if lo >= hi:
-        raise LoadRangeError(f"the tested loads {tested.tolist()} share no slip range")
-    degree = max(c.degree for c in ordered) if degree is None else degree
-    if degree not in DEGREES:
-        raise DegreeError(f"degree {degree!r} outside 3-7")
-    method = ("pchip" if tested.size >= 3 else "linear") if method == "auto" else method
-    branch = max(branch_terms(c) for c in ordered) if lo < 0 else 0
-    grid, projection = _projection(lo, hi, degree, grid_points, branch)
-    values = _across_load(tested, np.array([curve_value(c.coefficients, grid, c.step_below_zero,
-                                                        c.slope_below_zero) for c in ordered]),
-                          query, method, outside)
+    grid, projection = setup.grid, setup.projection
+    values = _across_load(tested, setup.values, query, method, outside)
     coefficients, below = branch_from_solution(values @ projection, lo, hi, degree)
     misfit = curve_value(coefficients[:, None, :], grid, below[:, :1], below[:, 1:]) - values
+    known = uncertainty and all(c.covariance is not None for c in ordered)
+    covariance = _propagate(ordered, tested, query, method, outside, grid,
+                            projection @ solution_to_parameters(lo, hi, degree,
+                                                                projection.shape[1])) \
+        if known else None
     return LoadCurves(loads_n=query, coefficients=coefficients, below_zero=below,
                       slip_min=lo, slip_max=hi,
                       method=method, tested_loads_n=tuple(tested.tolist()), extrapolated=outside,
-                      fit_rmse=np.sqrt(np.mean(misfit ** 2, axis=1)))
+                      fit_rmse=np.sqrt(np.mean(misfit ** 2, axis=1)), covariance=covariance,
+                      **(_linear_in_load(ordered, tested, query, outside) if known else {}))
+
+
+def _linear_in_load(ordered: list[PowerCurve], tested: np.ndarray, query: np.ndarray,
+                    outside: np.ndarray) -> dict[str, np.ndarray]:
+    """``scatter_sd`` and ``k95`` at the query loads: linear across load between the tested
+    curves' (a property of the rig at that load, not of one curve)."""
+    both = np.array([[c.scatter_sd, c.k95] for c in ordered])
+    out = _across_load(tested, both, query, "linear", outside)
+    return {"scatter_sd": np.maximum(out[:, 0], 0.0), "k95": np.maximum(out[:, 1], 0.0)}
+
+
+def _propagate(ordered: list[PowerCurve], tested: np.ndarray, query: np.ndarray, method: str,
+               outside: np.ndarray, grid: np.ndarray, to_theta: np.ndarray) -> np.ndarray:
+    """Covariance (queries x p x p) of the interpolated curves' parameters: the tested curves
+    are independent (different runs), the across-load step is linearised (its sensitivity
+    to each tested curve's grid values by a forward difference: PCHIP's slopes depend on the
+    values; exact for linear), the refit is linear (``to_theta``: grid values -> theta)."""
+    values = np.array([curve_value(c.coefficients, grid, c.step_below_zero, c.slope_below_zero)
+                       for c in ordered])
+    base = _across_load(tested, values, query, method, outside)
+    delta = 1e-6 * max(float(np.ptp(values)), float(np.max(np.abs(values))), 1e-300)
+    out = 0.0
+    for k, c in enumerate(ordered):
+        bumped = values.copy()
+        bumped[k] += delta
+        sensitivity = (_across_load(tested, bumped, query, method, outside) - base) / delta
+        design = parameter_gradient(grid, c.degree)  # grid x p_k
+        mapped = np.einsum("qg,gi,gj->qij", sensitivity, design, to_theta)  # q x p_k x p
+        out = out + np.einsum("qia,ij,qjb->qab", mapped, np.asarray(c.covariance), mapped)
+    return out
 
 
 def interpolate_load(curves: Mapping[float, PowerCurve], load_n: float,

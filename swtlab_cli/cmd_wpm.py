@@ -59,27 +59,62 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _inverse(wpm, args, chosen: dict) -> dict:
+    from fitting.band import band
+
     option = next(o for o in TARGETS if getattr(args, o) is not None)
     quantity, target = TARGETS[option], getattr(args, option)
     extrapolate = {"allow_extrapolation": args.allow_extrapolation}
     found = wpm.slip_for(quantity, target, args.load, **chosen, **extrapolate)
     curve = wpm.curve(quantity, args.load, **chosen, **extrapolate)
     slip = float(found.slip)
+    uncertainty = {"slip_conf_half95": None, "slip_pred_half95": None,
+                   "value_conf_half95": None, "value_pred_half95": None}
+    if curve.covariance is not None and str(found.status) in ("ok", "above_max"):
+        at = slip if str(found.status) == "ok" else _argmax(curve)
+        _, conf, pred = band(curve, at)
+        uncertainty.update(value_conf_half95=float(conf), value_pred_half95=float(pred))
+        if str(found.status) == "ok":
+            slip_conf, slip_pred = wpm.slip_band(quantity, slip, args.load, **chosen,
+                                                 **extrapolate)
+            uncertainty.update(slip_conf_half95=_finite(slip_conf),
+                               slip_pred_half95=_finite(slip_pred))
     return {"quantity": quantity, "unit": UNITS[quantity], "target": target,
             "slip": slip if slip == slip else None,  # NaN (below the curve) -> null
             "value": float(found.value), "status": str(found.status),
+            "uncertainty_known": curve.covariance is not None, **uncertainty,
             "slip_min": curve.slip_min, "slip_max": curve.slip_max, "method": curve.method,
             "tested_loads_n": list(curve.tested_loads_n), "extrapolated_load": curve.extrapolated}
 
 
+def _finite(x) -> float | None:
+    """A finite float, else None (JSON null: a zero slope leaves the slip undetermined)."""
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _argmax(curve) -> float:
+    """The slip of the curve's maximum over its fitted range (dense grid)."""
+    import numpy as np
+
+    s = np.linspace(curve.slip_min, curve.slip_max, 4001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return float(s[np.argmax(curve.evaluate(s))])
+
+
 def _values(wpm, args, chosen: dict) -> dict:
-    out = {"slip": args.slip, "values": {}, "units": {}, "outside_slip_range": {}}
+    from fitting.band import band
+
+    out = {"slip": args.slip, "values": {}, "units": {}, "outside_slip_range": {},
+           "conf_half95": {}, "pred_half95": {}}
     for quantity in wpm.quantities(**chosen):
         curve = wpm.curve(quantity, args.load, **chosen,
                           allow_extrapolation=args.allow_extrapolation)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             out["values"][quantity] = float(curve.evaluate(args.slip))
+        _, conf, pred = band(curve, args.slip)
+        out["conf_half95"][quantity], out["pred_half95"][quantity] = _finite(conf), _finite(pred)
         out["units"][quantity] = UNITS[quantity]
         out["outside_slip_range"][quantity] = bool(curve.outside_range(args.slip))
         out.update(method=curve.method, tested_loads_n=list(curve.tested_loads_n),
@@ -96,12 +131,16 @@ def _print_text(answer: dict) -> None:
         q, u = answer["quantity"], answer["unit"]
         if answer["status"] == "ok":
             print(f"{q} = {answer['target']:g} {u} at slip {answer['slip']:.6g}")
+            print(_slip_uncertainty(answer))
         elif answer["status"] == "at_step":
             print(f"{q} = {answer['target']:g} {u} at slip 0: inside the curve's jump at zero "
                   "slip (braked side to driven side)")
         elif answer["status"] == "above_max":
             print(f"{q} = {answer['target']:g} {u} is beyond the wheel: slip 1.0 (100 %), "
-                  f"maximum achievable {answer['value']:.6g} {u}")
+                  f"maximum achievable {answer['value']:.6g} {u}"
+                  + (f" +- {answer['value_conf_half95']:.3g} {u} (95 % confidence), the "
+                     "maximum over the fitted slip range" if answer["value_conf_half95"]
+                     is not None else ", the maximum over the fitted slip range"))
         else:
             print(f"{q} = {answer['target']:g} {u} is below the curve over slips "
                   f"[{answer['slip_min']:g}, {answer['slip_max']:g}]: no slip; minimum "
@@ -110,7 +149,25 @@ def _print_text(answer: dict) -> None:
     for q, v in answer["values"].items():
         flag = "  (outside the fitted slip range: extrapolated)" \
             if answer["outside_slip_range"][q] else ""
-        print(f"{q:13s} {v:.6g} {answer['units'][q]}{flag}")
+        conf, pred = answer["conf_half95"][q], answer["pred_half95"][q]
+        bands = f"  +- {conf:.3g} (95 % conf.), +- {pred:.3g} (one run, 95 % pred.)" \
+            if conf is not None else "  (uncertainty unknown: no uncertainty columns)"
+        print(f"{q:13s} {v:.6g} {answer['units'][q]}{bands}{flag}")
+
+
+def _slip_uncertainty(answer: dict) -> str:
+    """The slip's 95 % half-widths, or why there are none."""
+    if not answer["uncertainty_known"]:
+        return ("slip uncertainty unknown: the WPM CSV carries no uncertainty columns "
+                "(written before swtlab 0.4.0, or by another tool)")
+    conf, pred = answer["slip_conf_half95"], answer["slip_pred_half95"]
+    if conf is None:
+        return "slip uncertainty undetermined: the curve is flat there (slope 0)"
+    u = answer["unit"]
+    return (f"slip +- {conf:.3g} (95 % confidence of the curve), +- {pred:.3g} (95 % "
+            f"prediction for one run); from the {answer['quantity']} band +- "
+            f"{answer['value_conf_half95']:.3g} / {answer['value_pred_half95']:.3g} {u} "
+            f"through u_slip ~ u / |d {answer['quantity']} / d slip| (linearised)")
 
 
 def run_query(args: argparse.Namespace) -> int:

@@ -127,3 +127,35 @@ def test_extrapolation_on_request_warns(capsys, wpm_csv):
                           "--allow-extrapolation", "--json")
     assert code == 0 and json.loads(out)["extrapolated_load"] is True
     assert "warning: 1 load(s) outside the tested loads (70-300 N)" in err
+
+
+def test_dp_query_gives_the_slip_and_its_uncertainty(capsys, wpm_csv, tmp_path):
+    """Issue 18.4: the slip's 95 % half-widths are the DP band over the slope there
+    (u_slip = u_DP / |dDP/dslip|), checked against a finite-difference slope of the curve;
+    an older CSV without the uncertainty columns says the uncertainty is unknown."""
+    from fitting import band
+
+    code, out, _ = _run(capsys, wpm_csv, "--load", "120", "--dp", "25", "--multipass", "0",
+                        "--json")
+    answer = json.loads(out)
+    curve = WheelPerformanceModule.load(wpm_csv).curve("dp_n", 120.0, multipass=0)
+    s, h = answer["slip"], 1e-6
+    slope = float(curve.evaluate(s + h) - curve.evaluate(s - h)) / (2 * h)
+    _, conf, pred = band(curve, s)
+    assert answer["uncertainty_known"] is True
+    assert answer["value_conf_half95"] == pytest.approx(float(conf), rel=1e-9)
+    assert answer["slip_conf_half95"] == pytest.approx(float(conf) / abs(slope), rel=1e-6)
+    assert answer["slip_pred_half95"] == pytest.approx(float(pred) / abs(slope), rel=1e-6)
+    assert 0 < answer["slip_conf_half95"] < answer["slip_pred_half95"] < 0.05
+    code, out, _ = _run(capsys, wpm_csv, "--load", "120", "--dp", "25", "--multipass", "0")
+    assert code == 0 and "slip +- " in out and "(linearised)" in out
+    old = tmp_path / "old.csv"  # the same file without the three uncertainty columns
+    lines = open(wpm_csv).read().splitlines()
+    old.write_text("\n".join(ln if ln.startswith("#") else ",".join(ln.split(",")[:-3])
+                             for ln in lines) + "\n")
+    code, out, _ = _run(capsys, str(old), "--load", "120", "--dp", "25", "--multipass", "0")
+    assert code == 0 and "slip uncertainty unknown" in out
+    code, out, _ = _run(capsys, str(old), "--load", "120", "--dp", "25", "--multipass", "0",
+                        "--json")
+    assert json.loads(out)["slip_conf_half95"] is None
+    assert json.loads(out)["slip"] == pytest.approx(answer["slip"], abs=1e-12)

@@ -11,12 +11,13 @@ import pytest
 from fitting import fit_results
 from wpm_export import (COLUMNS, FORMAT, WpmFormatError, inputs_sha256, read_wpm_csv,
                         write_wpm_csv)
-from wpm_export.schema import BRANCH_COLUMNS
+from wpm_export.schema import BRANCH_COLUMNS, UNCERTAINTY_COLUMNS
 from test_fitting_synthetic import model_results_table
 
 HEADER = ",".join(COLUMNS)  # the layout without the braked-branch columns, still read
 GOOD_ROW = "sand,bb2,0,180,dp_n,N,3,-0.1,0.6,-11.0,200.0,-230.0,80.0,,,,,7,0.4"
-BRANCH_HEADER = ",".join(COLUMNS + BRANCH_COLUMNS)  # what swtlab writes
+BRANCH_HEADER = ",".join(COLUMNS + BRANCH_COLUMNS)  # before the uncertainty columns, still read
+FULL_HEADER = ",".join(COLUMNS + BRANCH_COLUMNS + UNCERTAINTY_COLUMNS)  # what swtlab writes
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +49,7 @@ def test_round_trip_gives_the_same_curves(tmp_path, table, fits):
         assert (c.step_below_zero, c.slope_below_zero) == (f.step_below_zero,
                                                            f.slope_below_zero)
         np.testing.assert_allclose(c.evaluate(s), f.evaluate(s), rtol=0, atol=1e-12)
+        assert (c.covariance, c.scatter_sd, c.k95) == (f.covariance, f.scatter_sd, f.k95)
 
 
 def test_rows_are_sorted_and_unused_coefficients_empty(tmp_path, fits):
@@ -55,7 +57,7 @@ def test_rows_are_sorted_and_unused_coefficients_empty(tmp_path, fits):
     write_wpm_csv(fits, path, "0" * 64, "0.1.0")
     lines = path.read_text().splitlines()
     assert lines[:4] == [f"# format: {FORMAT}", "# swtlab_version: 0.1.0",
-                         f"# inputs_sha256: {'0' * 64}", BRANCH_HEADER]
+                         f"# inputs_sha256: {'0' * 64}", FULL_HEADER]
     first = lines[4].split(",")
     assert first[:7] == ["bb2_sand", "bb2", "0", "70.0", "dp_n", "N", first[6]]
     degree = int(first[6])
@@ -104,6 +106,34 @@ def test_the_braked_branch_columns_are_read_and_evaluated(tmp_path):
     assert curve.evaluate(0.0) == -11.0  # zero slip: the driven side
     message = _bad(tmp_path, f"{GOOD_ROW},x,0", f"# format: {FORMAT}\n{BRANCH_HEADER}\n")
     assert message.startswith(":3: step_below_zero 'x' is not a number")
+
+
+def test_the_uncertainty_columns_give_the_band_by_hand(tmp_path):
+    """A cubic with J, K (m = 6 parameters): 21 numbers of the upper triangle; the variance at
+    s = 0.5 is g^T C g with g = (1, .5, .25, .125, 0, 0), by hand for a diagonal C."""
+    from fitting import band
+
+    diagonal = [4.0, 1.0, 0.5, 0.25, 2.0, 3.0]
+    upper = [diagonal[i] if i == j else 0.0 for i in range(6) for j in range(i, 6)]
+    path = tmp_path / "u.csv"
+    path.write_text(f"# format: {FORMAT}\n{FULL_HEADER}\n{GOOD_ROW},3.0,-20.0,2.0,1.5,"
+                    + " ".join(map(str, upper)) + "\n")
+    _, (curve,) = read_wpm_csv(path)
+    mean, conf, pred = band(curve, 0.5)
+    var = 4.0 + 0.25 * 1.0 + 0.0625 * 0.5 + 0.015625 * 0.25  # 4.2851...
+    assert mean == pytest.approx(-11 + 100 - 57.5 + 10)
+    assert conf == pytest.approx(2.0 * var ** 0.5) and pred == pytest.approx(
+        2.0 * (var + 1.5 ** 2) ** 0.5)
+    var_braked = 4.0 + 0.01 * 1.0 + 0.0001 * 0.5 + 1e-6 * 0.25 + 2.0 + 0.01 * 3.0  # s = -0.1
+    assert band(curve, -0.1)[1] == pytest.approx(2.0 * var_braked ** 0.5)
+    old = tmp_path / "old.csv"  # an older file: the uncertainty is unknown, not zero
+    old.write_text(f"# format: {FORMAT}\n{BRANCH_HEADER}\n{GOOD_ROW},3.0,-20.0\n")
+    _, (legacy,) = read_wpm_csv(old)
+    assert legacy.covariance is None and all(np.isnan(band(legacy, 0.5)[1:]))
+    prefix = f"# format: {FORMAT}\n{FULL_HEADER}\n"
+    assert ":3: covariance has 3 numbers; degree 3 needs 21" in _bad(
+        tmp_path, f"{GOOD_ROW},0,0,2.0,1.0,1 2 3", prefix)
+    assert "give all three or none" in _bad(tmp_path, f"{GOOD_ROW},0,0,2.0,,", prefix)
 
 
 def _bad(tmp_path, body: str, prefix: str = f"# format: {FORMAT}\n{HEADER}\n") -> str:

@@ -163,3 +163,73 @@ def test_loads_that_do_not_bracket_the_request(wpm):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         wpm.slip_for("dp_n", 25.0, 300.0, multipass=0)  # a tested load: silent
+
+
+def _bisection(curve, target, points: int = 200_001) -> float | None:
+    """Smallest slip where the curve reaches ``target``: the first sign change on a dense
+    grid, then bisection on the polynomial there to rounding (independent of the runtime)."""
+    s = np.linspace(curve.slip_min, curve.slip_max, points)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = curve.evaluate(s) - target
+    hit = np.flatnonzero((d[:-1] * d[1:] <= 0))
+    if not hit.size:
+        return None
+    lo, hi = s[hit[0]], s[hit[0] + 1]
+    f_lo = float(curve.evaluate(lo)) - target
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        f_mid = float(curve.evaluate(mid)) - target
+        if (f_mid <= 0) == (f_lo <= 0) and f_mid != 0:
+            lo, f_lo = mid, f_mid
+        else:
+            hi = mid
+    return hi if f_lo != 0 else lo
+
+
+@pytest.mark.parametrize("quantity", ["dp_n", "torque_nm", "sinkage_m", "resistance_n"])
+def test_every_path_of_the_inverse_is_exact_to_1e_6_against_bisection(wpm, quantity):
+    """Issue 19.1: the cached table (one load), the table look-up of ``slip_for_one`` and the
+    row solver (many loads) against bisection on the curve of ``interpolate_loads`` (not the
+    runtime's load polynomial), at tested and untested loads, targets spread over each
+    curve's range and crowded just below its maximum (where the slope vanishes)."""
+    rng = np.random.default_rng(11)
+    loads = [70.0, 97.3, 120.0, 180.0, 244.4, 300.0]
+    many_loads, many_targets, expected_many = [], [], []
+    for load in loads:
+        curve = wpm.curve(quantity, load, multipass=0)
+        s = np.linspace(curve.slip_min, curve.slip_max, 200_001)
+        v = curve.evaluate(s)
+        span = v.max() - v.min()
+        targets = np.concatenate([rng.uniform(v.min(), v.max(), 12),
+                                  v.max() - span * np.array([1e-3, 1e-5, 1e-7])])
+        expected = [_bisection(curve, t) for t in targets]
+        table = wpm.slip_for(quantity, targets, load, multipass=0)
+        for t, e, slip in zip(targets, expected, table.slip):
+            assert e is not None and slip == pytest.approx(e, abs=1e-6), (load, t)
+            one = wpm.slip_for_one(quantity, t, load, multipass=0)
+            assert one[0] == pytest.approx(e, abs=1e-6) and one[2] in ("ok", "at_step")
+        many_loads += [load] * targets.size
+        many_targets += list(targets)
+        expected_many += expected
+    rows = wpm.slip_for(quantity, many_targets, many_loads * 1, multipass=0)
+    assert len(set(many_loads)) > 5  # more loads than the tables serve: the row solver
+    np.testing.assert_allclose(rows.slip, expected_many, rtol=0, atol=1e-6)
+
+
+def test_a_turning_point_between_grid_cells_is_found_by_every_path():
+    """A hand-made curve y = 100/3 s^3 - 40 s^2 + 15 s (y' = 100 (s - 0.3)(s - 0.5)): a
+    peak of 1.8 at s = 0.3, a dip to 1.667 at 0.5, 8.33 at s = 1. Just below the peak and
+    at it the target is met before 0.3; above it only after the dip."""
+    a = (0.0, 15.0, -40.0, 100.0 / 3.0)
+    curve = WpmCurve(a, 0.0, 1.0, soil="s", wheel="w", multipass=0, load_n=100.0,
+                     quantity="dp_n", unit="N", n_points=8, rmse=0.0, line=3)
+    wpm = WheelPerformanceModule([curve])
+    peak = 1.8  # 15 * 0.3 - 40 * 0.09 + 100/3 * 0.027
+    targets = [peak - 1e-4, peak, peak + 0.05, 0.5, peak * 2]
+    expected = [_bisection(curve, t) for t in targets]
+    by_rows = solve_slip([a], [0] * len(targets), targets, 0.0, 1.0)
+    by_table = wpm.slip_for("dp_n", targets, 100.0)
+    np.testing.assert_allclose(by_rows.slip, expected, atol=1e-6)
+    np.testing.assert_allclose(by_table.slip, expected, atol=1e-6)
+    assert by_rows.status.tolist() == by_table.status.tolist() == ["ok"] * 5

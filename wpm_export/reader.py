@@ -11,14 +11,19 @@ from pathlib import Path
 
 from fitting.curve import DEGREES, PowerCurve
 from swtlab.domain import Wheel
-from wpm_export.schema import (BRANCH_COLUMNS, COEFFICIENT_COLUMNS, COLUMNS, FORMAT, UNITS,
-                               WHEEL_GEOMETRY_KEY, WHEEL_KEYS, WpmFormatError)
+from wpm_export.schema import (BRANCH_COLUMNS, COEFFICIENT_COLUMNS, COLUMNS, FORMAT,
+                               UNCERTAINTY_COLUMNS, UNITS, WHEEL_GEOMETRY_KEY, WHEEL_KEYS,
+                               WpmFormatError)
+
+#: the column headers a reader accepts: today's, without the uncertainty, without the branch
+HEADERS = (COLUMNS + BRANCH_COLUMNS + UNCERTAINTY_COLUMNS, COLUMNS + BRANCH_COLUMNS, COLUMNS)
 
 
 @dataclass(frozen=True)
 class WpmCurve(PowerCurve):
     """One row of a WPM CSV: ``sum_i a_i slip**i + [slip < 0] (J + K slip)`` on
-    [slip_min, slip_max]."""
+    [slip_min, slip_max], with its uncertainty where the file carries it (``covariance``
+    None and NaN ``k95``, ``scatter_sd`` where not: unknown)."""
 
     soil: str
     wheel: str
@@ -86,8 +91,39 @@ def _curve(fields: list[str], problem, line: int, columns: tuple[str, ...]) -> W
     step, slope = (_number(row[c], c, problem) if c in row else 0.0 for c in BRANCH_COLUMNS)
     return WpmCurve(coefficients=coefficients, slip_min=slip_min, slip_max=slip_max,
                     step_below_zero=step, slope_below_zero=slope,
+                    **_uncertainty(row, degree, problem),
                     soil=row["soil"], wheel=row["wheel"], multipass=multipass, load_n=load_n,
                     quantity=quantity, unit=row["unit"], n_points=n_points, rmse=rmse, line=line)
+
+
+def _uncertainty(row: dict[str, str], degree: int, problem) -> dict:
+    """``k95``, ``scatter_sd``, ``covariance`` of a row (docs/wpm-csv.md, "Uncertainty"):
+    all three empty (or absent) = unknown; else k95 > 0, scatter_sd >= 0 and the
+    (degree + 3)(degree + 4)/2 numbers of the upper triangle, diagonal >= 0."""
+    fields = [row.get(c, "") for c in UNCERTAINTY_COLUMNS]
+    if not any(fields):
+        return {}
+    if not all(fields):
+        raise problem(f"{', '.join(UNCERTAINTY_COLUMNS)}: give all three or none")
+    k95 = _number(fields[0], "k95", problem)
+    scatter = _number(fields[1], "scatter_sd", problem)
+    if k95 <= 0 or scatter < 0:
+        raise problem(f"k95 {k95:g} must be > 0 and scatter_sd {scatter:g} >= 0")
+    upper = [_number(v, "covariance", problem) for v in fields[2].split()]
+    m = degree + 3
+    if len(upper) != m * (m + 1) // 2:
+        raise problem(f"covariance has {len(upper)} numbers; degree {degree} needs "
+                      f"{m * (m + 1) // 2} (upper triangle of {m} x {m})")
+    matrix = [[0.0] * m for _ in range(m)]
+    k = 0
+    for i in range(m):
+        for j in range(i, m):
+            matrix[i][j] = matrix[j][i] = upper[k]
+            k += 1
+    if any(matrix[i][i] < 0 for i in range(m)):
+        raise problem("covariance has a negative variance on its diagonal")
+    return {"k95": k95, "scatter_sd": scatter,
+            "covariance": tuple(tuple(r) for r in matrix)}
 
 
 def wheel_geometry(header: dict[str, str], path="<text>", line: int = 0) -> dict[str, Wheel]:
@@ -145,9 +181,10 @@ def parse_wpm_csv(text: str, path="<text>") -> tuple[dict[str, str], list[WpmCur
                               if "format" not in header else
                               f"format {header['format']!r}, this reader reads {FORMAT!r}")
             columns = tuple(f.strip() for f in next(csv.reader([raw])))
-            if columns not in (COLUMNS + BRANCH_COLUMNS, COLUMNS):
-                raise problem(f"column header must be {','.join(COLUMNS + BRANCH_COLUMNS)} "
-                              f"(or without {', '.join(BRANCH_COLUMNS)})")
+            if columns not in HEADERS:
+                raise problem(f"column header must be {','.join(HEADERS[0])} (or without "
+                              f"{', '.join(UNCERTAINTY_COLUMNS)}, or without those and "
+                              f"{', '.join(BRANCH_COLUMNS)})")
             columns_line = number
             continue
         curve = _curve(next(csv.reader([raw])), problem, number, columns)

@@ -2,6 +2,12 @@
 and the slip that gives a required DP, torque, sinkage or resistance (RUAG WPM), from a WPM
 CSV. Loads between the tested ones are interpolated on curve values exactly as in
 :mod:`fitting.load_interp`; all queries are vectorised over numpy arrays.
+
+Caches (docs/wpm-csv.md, "Embedding"): per (curve set, quantity) the curves' parameters as
+an exact piecewise polynomial of load (:class:`fitting.load_interp.LoadPolynomial`); per
+(curve set, quantity, load) asked for a second time, the curve there with its uncertainty and
+its monotone inverse table (:class:`wpm_export.inverse_table.InverseTable`). Loads seen once,
+and many loads in one call, go to the row solver (:func:`wpm_export.inverse.solve_slip`).
 """
 
 from __future__ import annotations
@@ -11,15 +17,19 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from fitting.band import band
 from fitting.errors import OutsideSlipRangeWarning
-from fitting.load_interp import InterpolatedCurve, LoadCurves, interpolate_loads
-from fitting.polynomial import curve_value
-from wpm_export.inverse import SlipSolution, solve_slip
+from fitting.load_interp import InterpolatedCurve, LoadCurves, LoadPolynomial, interpolate_loads
+from fitting.polynomial import curve_value, horner
 from swtlab.domain import Wheel
+from wpm_export.inverse import SlipSolution, solve_slip
+from wpm_export.inverse_table import InverseTable
 from wpm_export.reader import WpmCurve, read_wpm_csv, wheel_geometry
 from wpm_export.schema import UNITS, WpmSelectionError
 
 CurveSet = tuple[str, str, int]  # (soil, wheel, multipass)
+TABLE_LOADS = 8  # a call with at most this many distinct loads uses (and builds) their tables
+MAX_TABLES = 4096  # cached tables kept (oldest dropped first)
 
 
 class WheelPerformanceModule:
@@ -36,6 +46,10 @@ class WheelPerformanceModule:
         self.header, self.source, self.load_method = dict(header or {}), source, load_method
         self.wheels: dict[str, Wheel] = wheel_geometry(self.header, source)
         self._sets: dict[CurveSet, dict[str, dict[float, WpmCurve]]] = {}
+        self._polynomials: dict[tuple, LoadPolynomial] = {}
+        self._tables: dict[tuple, tuple[InverseTable, InterpolatedCurve]] = {}
+        self._seen: set[tuple] = set()
+        self._fast: dict[tuple, tuple[InverseTable, InterpolatedCurve]] = {}
         for c in curves:
             by_quantity = self._sets.setdefault((c.soil, c.wheel, c.multipass), {})
             by_quantity.setdefault(c.quantity, {})[c.load_n] = c
@@ -73,8 +87,9 @@ class WheelPerformanceModule:
         the choices."""
         match = [k for k in self.sets() if (soil is None or k[0] == soil)
                  and (wheel is None or k[1] == wheel) and (multipass is None or k[2] == multipass)]
-        choices = "; ".join(f"--soil {s} --wheel {w} --multipass {m}" for s, w, m in self.sets())
         if not match:
+            choices = "; ".join(f"--soil {s} --wheel {w} --multipass {m}"
+                                for s, w, m in self.sets())
             raise WpmSelectionError(f"no curves for soil={soil} wheel={wheel} "
                                     f"multipass={multipass} in {self.source}; choices: {choices}")
         if len(match) > 1:
@@ -95,20 +110,23 @@ class WheelPerformanceModule:
                                     + ", ".join(self.quantities(**selection)))
         return self._sets[key][quantity]
 
-    def _curves_at(self, quantity: str, loads_n, selection: dict,
-                   allow_extrapolation: bool) -> tuple[LoadCurves, np.ndarray]:
-        """Curves at the distinct loads of ``loads_n`` and the index of each load's curve."""
+    def _curves_at(self, quantity: str, loads_n, selection: dict, allow_extrapolation: bool,
+                   uncertainty: bool = False) -> tuple[LoadCurves, np.ndarray]:
+        """Curves at the distinct loads of ``loads_n`` and the index of each load's curve
+        (with their covariance only when ``uncertainty``: it costs per load)."""
         unique, inverse = np.unique(np.asarray(loads_n, dtype=float).ravel(), return_inverse=True)
         curves = interpolate_loads(self._by_load(quantity, selection), unique,
                                    method=self.load_method,
-                                   allow_extrapolation=allow_extrapolation)
+                                   allow_extrapolation=allow_extrapolation,
+                                   uncertainty=uncertainty)
         return curves, inverse
 
     def curve(self, quantity: str, load_n: float, *, soil=None, wheel=None, multipass=None,
               allow_extrapolation: bool = False) -> InterpolatedCurve:
-        """The ``quantity`` curve at ``load_n`` (N)."""
+        """The ``quantity`` curve at ``load_n`` (N), with its bands (:func:`fitting.band`)."""
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
-        return self._curves_at(quantity, [load_n], selection, allow_extrapolation)[0].curve(0)
+        return self._curves_at(quantity, [load_n], selection, allow_extrapolation,
+                               uncertainty=True)[0].curve(0)
 
     def at_slip(self, slip, load_n, *, soil=None, wheel=None, multipass=None,
                 allow_extrapolation: bool = False) -> dict[str, np.ndarray]:
@@ -130,18 +148,115 @@ class WheelPerformanceModule:
                           OutsideSlipRangeWarning, stacklevel=2)
         return out
 
+    def _polynomial(self, quantity: str, selection: dict) -> tuple[tuple, LoadPolynomial]:
+        key = (self.select(**selection), quantity)
+        if key not in self._polynomials:
+            self._polynomials[key] = LoadPolynomial(self._by_load(quantity, selection),
+                                                    method=self.load_method)
+        return key, self._polynomials[key]
+
+    def _table(self, key: tuple, quantity: str, load_n: float, selection: dict,
+               allow_extrapolation: bool, build: bool):
+        """The cached (inverse table, curve) at one load, built when ``build`` (else None if
+        not cached); the load checked (and warned about) on every call."""
+        entry = self._tables.get((key, load_n))
+        if entry is None:
+            if not build:
+                return None
+            curve = self.curve(quantity, load_n, **selection,
+                               allow_extrapolation=allow_extrapolation)
+            entry = (InverseTable(curve.coefficients, curve.slip_min, curve.slip_max,
+                                  curve.step_below_zero, curve.slope_below_zero), curve)
+            if len(self._tables) >= MAX_TABLES:
+                del self._tables[next(iter(self._tables))]
+            self._tables[(key, load_n)] = entry
+        elif entry[1].extrapolated:
+            self._polynomials[key].parameters([load_n], allow_extrapolation)  # raise or warn
+        return entry
+
+    def slip_for_one(self, quantity: str, target: float, load_n: float, *, soil=None,
+                     wheel=None, multipass=None, allow_extrapolation: bool = False
+                     ) -> tuple[float, float, str]:
+        """:meth:`slip_for` of one target at one load as ``(slip, value, status)`` floats and
+        text: the call a simulator makes in its loop (the load's table is built the second
+        time the load is asked for, then every call is a table look-up)."""
+        fast = self._fast.get((quantity, soil, wheel, multipass, load_n))
+        if fast is not None and not fast[1].extrapolated and target - target == 0.0:
+            return fast[0].solve(target)
+        selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
+        key, polynomial = self._polynomial(quantity, selection)
+        load_n, target = float(load_n), float(target)
+        if target - target != 0.0:
+            raise ValueError("targets must be finite numbers")
+        seen = (key, load_n) in self._seen
+        entry = self._table(key, quantity, load_n, selection, allow_extrapolation, seen)
+        if entry is None:
+            self._seen.add((key, load_n))
+            found = self._rows(polynomial, [target], [load_n], allow_extrapolation)
+            return float(found.slip[0]), float(found.value[0]), str(found.status[0])
+        if len(self._fast) >= MAX_TABLES:
+            del self._fast[next(iter(self._fast))]
+        self._fast[(quantity, soil, wheel, multipass, load_n)] = entry
+        return entry[0].solve(target)
+
+    @staticmethod
+    def _rows(polynomial: LoadPolynomial, target, load, allow_extrapolation: bool
+              ) -> SlipSolution:
+        unique, index = np.unique(np.asarray(load, dtype=float), return_inverse=True)
+        theta, _ = polynomial.parameters(unique, allow_extrapolation)
+        degree = polynomial.degree
+        return solve_slip(theta[:, :degree + 1], index, target, polynomial.slip_min,
+                          polynomial.slip_max, theta[:, degree + 1:])
+
     def slip_for(self, quantity: str, target, load_n, *, soil=None, wheel=None, multipass=None,
                  allow_extrapolation: bool = False) -> SlipSolution:
         """The smallest slip at which the wheel gives ``target`` of ``quantity`` at ``load_n``
-        (broadcast together); slip 1.0 and the maximum where the target is above the curve,
-        slip 0.0 and status ``at_step`` where it falls inside the jump at zero slip
-        (:mod:`wpm_export.inverse`)."""
+        (broadcast together); slip 1.0 and the maximum where the target is above the curve
+        (the maximum over the fitted slip range), slip 0.0 and status ``at_step`` where it
+        falls inside the jump at zero slip (:mod:`wpm_export.inverse`); ``value`` is the
+        target where it is reached. Exact to 1e-8 in slip (tables) or rounding (rows)."""
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
+        key, polynomial = self._polynomial(quantity, selection)
+        if np.ndim(load_n) == 0:  # one load: its table
+            target = np.asarray(target, dtype=float)
+            if not np.isfinite(target).all():
+                raise ValueError("targets must be finite numbers")
+            table, _ = self._table(key, quantity, float(load_n), selection,
+                                   allow_extrapolation, True)
+            slip, value, status = table.solve_many(target)
+            return SlipSolution(slip=slip, value=value, status=status)
         target, load = np.broadcast_arrays(np.asarray(target, dtype=float),
                                            np.asarray(load_n, dtype=float))
-        curves, index = self._curves_at(quantity, load, selection, allow_extrapolation)
-        found = solve_slip(curves.coefficients, index, target.ravel(), curves.slip_min,
-                           curves.slip_max, curves.below_zero)
-        shape = target.shape
+        if not np.all(np.isfinite(target)):
+            raise ValueError("targets must be finite numbers")
+        shape, target, load = target.shape, target.ravel(), load.ravel()
+        unique = np.unique(load)
+        if unique.size > TABLE_LOADS:
+            found = self._rows(polynomial, target, load, allow_extrapolation)
+        else:
+            slip, value = np.empty(target.shape), np.empty(target.shape)
+            status = np.empty(target.shape, dtype="<U9")
+            for w in unique.tolist():
+                at = load == w if unique.size > 1 else slice(None)
+                table, _ = self._table(key, quantity, w, selection, allow_extrapolation, True)
+                slip[at], value[at], status[at] = table.solve_many(target[at])
+            found = SlipSolution(slip=slip, value=value, status=status)
         return SlipSolution(slip=found.slip.reshape(shape), value=found.value.reshape(shape),
                             status=found.status.reshape(shape))
+
+    def slip_band(self, quantity: str, slip, load_n: float, *, soil=None, wheel=None,
+                  multipass=None, allow_extrapolation: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """95 % half-widths ``(confidence, prediction)`` of the slip found for a target at
+        one load: the curve's bands at that slip over its slope there, ``u_slip = u_y /
+        |dy/ds|`` (linearised; NaN where the curve has no uncertainty, inf where the slope
+        is 0; NaN slips stay NaN)."""
+        curve = self.curve(quantity, load_n, soil=soil, wheel=wheel, multipass=multipass,
+                           allow_extrapolation=allow_extrapolation)
+        s = np.asarray(slip, dtype=float)
+        _, conf, pred = band(curve, s)
+        a = np.array(curve.coefficients)
+        slope = horner(a[1:] * np.arange(1, a.size), s) + np.where(
+            s < 0, curve.slope_below_zero, 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return conf / np.abs(slope), pred / np.abs(slope)

@@ -12,6 +12,10 @@ COLUMNS = (("soil", "wheel", "multipass", "load_n", "quantity", "unit", "degree"
 #: the braked branch ``[slip < 0] (J + K slip)`` (docs/fitting.md), written after the others;
 #: a file without them (older swtlab, other tools) reads as J = K = 0
 BRANCH_COLUMNS = ("step_below_zero", "slope_below_zero")
+#: the curve's uncertainty (docs/wpm-csv.md, "Uncertainty"), written after the branch: the
+#: 95 % factor, the run-to-run SD and the upper triangle of the covariance of
+#: (a0 ... a_n, J, K); a file without them reads as unknown uncertainty
+UNCERTAINTY_COLUMNS = ("k95", "scatter_sd", "covariance")
 UNITS = QUANTITY_UNITS  # dp_n N, torque_nm N*m, sinkage_m m, resistance_n N, dp_over_w 1
 #: header key of the wheels' geometry (JSON: name -> WHEEL_KEYS)
 WHEEL_GEOMETRY_KEY = "wheel_geometry"

@@ -8,6 +8,7 @@ import io
 import json
 from collections.abc import Iterable
 
+import numpy as np
 import pandas as pd
 
 from fitting.curve import CurveFit
@@ -15,8 +16,8 @@ from fitting.table import KEY_COLUMNS, MEASURED
 from wpm_export.reader import parse_wpm_csv
 from swtlab.atomic import write_atomically
 from swtlab.domain import Wheel
-from wpm_export.schema import (BRANCH_COLUMNS, COLUMNS, FORMAT, MAX_DEGREE, UNITS,
-                               WHEEL_GEOMETRY_KEY, WHEEL_KEYS)
+from wpm_export.schema import (BRANCH_COLUMNS, COLUMNS, FORMAT, MAX_DEGREE,
+                               UNCERTAINTY_COLUMNS, UNITS, WHEEL_GEOMETRY_KEY, WHEEL_KEYS)
 
 #: the columns of a results table the fits read, in the order they are hashed
 HASHED_COLUMNS = (KEY_COLUMNS + ("slip", "slip_se", "wheel_load_n", "wheel_load_n_se")
@@ -56,7 +57,19 @@ def _row(fit: CurveFit) -> list[str]:
             UNITS[fit.quantity], str(fit.degree), repr(float(fit.slip_min)),
             repr(float(fit.slip_max)), *coefficients, *[""] * (MAX_DEGREE + 1 - len(coefficients)),
             str(int(fit.n_points)), repr(float(fit.rmse)),
-            repr(float(fit.step_below_zero)), repr(float(fit.slope_below_zero))]
+            repr(float(fit.step_below_zero)), repr(float(fit.slope_below_zero)),
+            *_uncertainty(fit)]
+
+
+def _uncertainty(fit: CurveFit) -> list[str]:
+    """``k95``, ``scatter_sd`` and the covariance's upper triangle (row-major, space
+    separated); three empty fields for a curve without uncertainty."""
+    if fit.covariance is None:
+        return ["", "", ""]
+    c = np.asarray(fit.covariance, dtype=float)
+    upper = c[np.triu_indices(c.shape[0])]
+    return [repr(float(fit.k95)), repr(float(fit.scatter_sd)),
+            " ".join(repr(float(v)) for v in upper)]
 
 
 def _geometry(wheels: dict[str, Wheel], names: set[str]) -> str:
@@ -84,7 +97,7 @@ def wpm_csv_text(fits: Iterable[CurveFit], inputs_sha256: str, swtlab_version: s
     if wheels is not None:
         out.write(f"# {WHEEL_GEOMETRY_KEY}: {_geometry(wheels, {f.wheel for f in rows})}\n")
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(COLUMNS + BRANCH_COLUMNS)
+    writer.writerow(COLUMNS + BRANCH_COLUMNS + UNCERTAINTY_COLUMNS)
     writer.writerows(_row(f) for f in rows)
     parse_wpm_csv(out.getvalue(), "<WPM CSV being written>")
     return out.getvalue()
