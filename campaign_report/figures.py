@@ -36,57 +36,100 @@ def _robust_limits(ax, values: np.ndarray) -> None:
     ax.set_ylim(lo - pad, hi + pad)
 
 
-def _no_data(ax, text: str) -> None:
-    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4",
+def _no_data(ax, text: str):
+    return ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4",
             bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85})
 
 
+class RunTimeseries:
+    """One figure of drawbar pull, torque, sinkage and slip against time, reused for every
+    run of a page: its axes, ticks, labels and grid are made once and each :meth:`draw`
+    replaces only the run's own artists (a figure made anew per run spent most of its time
+    creating ticks)."""
+
+    def __init__(self, palette: Palette) -> None:
+        self.palette = palette
+        # fixed margins: constrained layout would double the cost
+        self.figure = Figure(figsize=(8.0, 6.4))
+        self.axes = self.figure.subplots(len(TRACE_QUANTITIES), 1, sharex=True)
+        for ax, key in zip(self.axes, TRACE_QUANTITIES):
+            ax.set_ylabel(QUANTITIES[key].axis_label)
+            ax.grid(alpha=0.3)
+        self.axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
+        self.title = self.figure.suptitle("", fontsize="medium")
+        self._drawn: list = []  # the artists of the run drawn last
+        self._legends: dict = {}  # (labels, trace colour) -> legend
+
+    def _clear(self) -> None:
+        for artist in self._drawn:
+            artist.remove()
+        self._drawn = []
+        for ax in self.axes:
+            ax.relim()  # no data left: limits from this run's artists only
+            ax.set_autoscale_on(True)
+
+    def _legend(self, colour: str) -> None:
+        labelled = {}
+        for ax in self.axes:
+            labelled.update(zip(*reversed(ax.get_legend_handles_labels())))
+        key = (tuple(labelled), colour)
+        if key not in self._legends:
+            self._legends[key] = self.figure.legend(
+                labelled.values(), labelled.keys(), loc="lower center", ncols=len(labelled),
+                frameon=False, fontsize="small")
+        self.figure.legends[:] = [self._legends[key]]
+
+    def draw(self, run: RunRecord) -> Figure:
+        """The figure showing ``run``: its stored traces (min/max per block,
+        ``run_results.traces``), the stable window shaded with each quantity's mean over it;
+        a run with no stable phase gets the reason in its title. A run processed before
+        traces were stored says so (and shows its stored DP trace, if it has no stable
+        phase)."""
+        self._clear()
+        top = 0.93 if run.status != "no_stable_phase" else 0.86
+        self.figure.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
+        colour = self.palette.colour(run.load_n)
+        drawn = self._drawn
+        for ax, key in zip(self.axes, TRACE_QUANTITIES):
+            q = QUANTITIES[key]
+            y_data = False
+            if run.window_start_s is not None and run.window_end_s is not None:
+                drawn.append(ax.axvspan(run.window_start_s, run.window_end_s,
+                                        color=WINDOW_COLOUR, zorder=0, label="stable window"))
+                if key in run.means:
+                    drawn.append(ax.hlines(run.means[key] * q.scale, run.window_start_s,
+                                           run.window_end_s, colors="k", linestyles="--",
+                                           lw=1.2, label="mean over window"))
+                    y_data = True
+            trace = None if run.traces is None else run.traces.get(key)
+            if trace is not None:
+                values = np.asarray(trace.values, float) * q.scale
+                drawn += ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
+                _robust_limits(ax, values)
+                continue
+            drawn.append(_no_data(ax, NOT_STORED if run.traces is None else "not measured"))
+            if key == "dp_n" and run.traces is None and run.dp_trace:  # older results: this
+                dp = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
+                drawn += ax.plot(run.dp_trace["t_s"], dp, color="k", lw=1.0,
+                                 label="stored DP trace")
+                y_data = True
+            if not y_data:
+                ax.set_ylim(0.0, 1.0)
+        self._legend(colour)
+        title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass "
+                 f"{run.multipass}" + (f", slip set {100 * run.slip_setpoint:g} %"
+                                       if run.slip_setpoint is not None else ""))
+        if run.status == "no_stable_phase":
+            reason = plain_text("; ".join(run.flags))
+            title += "\n" + "\n".join(textwrap.wrap(reason, 110))
+        self.title.set_text(title)
+        self.title.set_color("#a00000" if run.status != "ok" else "k")
+        return self.figure
+
+
 def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
-    """Drawbar pull, torque, sinkage and slip against time from the traces stored at
-    processing (min/max per block, ``run_results.traces``), the stable window shaded with
-    each quantity's mean over it; a run with no stable phase gets the reason in its title.
-    A run processed before traces were stored says so (and shows its stored DP trace, if it
-    has no stable phase)."""
-    fig = Figure(figsize=(8.0, 6.4))  # fixed margins: constrained layout would double the cost
-    axes = fig.subplots(len(TRACE_QUANTITIES), 1, sharex=True)
-    top = 0.93 if run.status != "no_stable_phase" else 0.86
-    fig.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
-    colour = palette.colour(run.load_n)
-    for ax, key in zip(axes, TRACE_QUANTITIES):
-        q = QUANTITIES[key]
-        ax.set_ylabel(q.axis_label)
-        ax.grid(alpha=0.3)
-        if run.window_start_s is not None and run.window_end_s is not None:
-            ax.axvspan(run.window_start_s, run.window_end_s, color=WINDOW_COLOUR, zorder=0,
-                       label="stable window")
-            if key in run.means:
-                ax.hlines(run.means[key] * q.scale, run.window_start_s, run.window_end_s,
-                          colors="k", linestyles="--", lw=1.2, label="mean over window")
-        trace = None if run.traces is None else run.traces.get(key)
-        if trace is not None:
-            values = np.asarray(trace.values, float) * q.scale
-            ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
-            _robust_limits(ax, values)
-            continue
-        _no_data(ax, NOT_STORED if run.traces is None else "not measured")
-        if key == "dp_n" and run.traces is None and run.dp_trace:  # older results: this only
-            dp = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
-            ax.plot(run.dp_trace["t_s"], dp, color="k", lw=1.0, label="stored DP trace")
-    axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
-    labelled = {}
-    for ax in axes:
-        labelled.update(zip(*reversed(ax.get_legend_handles_labels())))
-    fig.legend(labelled.values(), labelled.keys(), loc="lower center", ncols=len(labelled),
-               frameon=False, fontsize="small")
-    title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass {run.multipass}"
-             + (f", slip set {100 * run.slip_setpoint:g} %" if run.slip_setpoint is not None
-                else ""))
-    if run.status == "no_stable_phase":
-        reason = plain_text("; ".join(run.flags))
-        title += "\n" + "\n".join(textwrap.wrap(reason, 110))
-    fig.suptitle(title, fontsize="medium",
-                 color="#a00000" if run.status != "ok" else "k")
-    return fig
+    """One run's time-series figure on a figure of its own (:class:`RunTimeseries`)."""
+    return RunTimeseries(palette).draw(run)
 
 
 def _errorbars(ax, rows: pd.DataFrame, key: str, colour: str, marker: str,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
+from functools import lru_cache
 from html import escape
 
 from campaign_report import figures
@@ -77,10 +78,16 @@ def runs_section(data: CampaignData) -> Section:
         html_columns=frozenset({0, 6}))])
 
 
+@lru_cache(maxsize=1)
+def _timeseries_figure(palette: Palette) -> figures.RunTimeseries:
+    """The time-series figure of the page whose palette this is, reused for all its runs."""
+    return figures.RunTimeseries(palette)
+
+
 def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Image:
     """A run's time-series thumbnail/full-size pair; the caption says so when the run was
     processed before its traces were stored."""
-    png, image = to_png(figures.run_timeseries(run, palette))
+    png, image = to_png(_timeseries_figure(palette).draw(run))
     caption = (f"{run.run_id} · {run.status}"
                + (f" · {figures.NOT_STORED}" if run.traces is None else ""))
     return Image(run_anchor(index), caption, png, thumbnail(image), run.status)
