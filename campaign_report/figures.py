@@ -9,6 +9,7 @@ import warnings
 
 import numpy as np
 import pandas as pd
+from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
@@ -24,6 +25,8 @@ from wpm_export import WheelPerformanceModule
 NOT_STORED = "trace not stored; re-run swtlab process"
 WINDOW_COLOUR = "#cfe3cf"
 CURVE_POINTS = 200
+MARKER_PT = 5.0  # marker size of the curves' points
+NORMAL_K = 1.96  # coverage factor of a 95 % interval without a budget
 
 
 def _robust_limits(ax, values: np.ndarray) -> None:
@@ -132,13 +135,52 @@ def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
     return RunTimeseries(palette).draw(run)
 
 
+def expanded_uncertainty(rows: pd.DataFrame, key: str) -> pd.Series | None:
+    """Each point's 95 % expanded uncertainty ``k sigma``: sigma the fits' (``<q>_se`` of the
+    fitting table: the larger of the run's combined standard uncertainty and its replicate
+    spread), k the coverage factor of the run's budget (``<q>_k``; 1.96 without one)."""
+    if f"{key}_se" not in rows:
+        return None
+    k = rows[f"{key}_k"].astype(float).fillna(NORMAL_K) if f"{key}_k" in rows else NORMAL_K
+    return rows[f"{key}_se"].astype(float) * k
+
+
 def _errorbars(ax, rows: pd.DataFrame, key: str, colour: str, marker: str,
                fitted: bool) -> None:
     q = QUANTITIES[key]
-    se = rows[f"{key}_se"] if f"{key}_se" in rows else None
+    u = expanded_uncertainty(rows, key)
     ax.errorbar(rows["slip"] * 100.0, rows[key] * q.scale,
-                yerr=None if se is None else se * q.scale, fmt=marker, ms=5, color=colour,
-                mfc=colour if fitted else "white", capsize=2.5, lw=1, zorder=3)
+                yerr=None if u is None else u * q.scale, fmt=marker, ms=MARKER_PT,
+                color=colour, mfc=colour if fitted else "white", capsize=2.5, lw=1, zorder=3)
+
+
+def hidden_errorbars(fig: Figure, keys) -> str | None:
+    """After ``fig`` is drawn: the error bars (:func:`_errorbars`) no longer than the marker
+    radius, per panel (``keys``: each panel's quantity) with the largest of them in the
+    display unit, as one sentence; None when every bar can be seen."""
+    radius_px = MARKER_PT * fig.dpi / 72.0 / 2.0 + 1.0  # + a pixel of anti-aliasing
+    parts = []
+    for ax, key in zip(fig.axes, keys):
+        hidden, total = [], 0
+        for container in ax.containers:
+            if not isinstance(container, ErrorbarContainer) or not container.has_yerr:
+                continue
+            for collection in container.lines[2]:  # (data line, caps, bar collections)
+                for segment in collection.get_segments():
+                    total += 1
+                    y0_px, y1_px = ax.transData.transform(segment)[:, 1]
+                    if abs(y1_px - y0_px) / 2.0 <= radius_px:
+                        hidden.append(abs(segment[1][1] - segment[0][1]) / 2.0)
+        if hidden:
+            q = QUANTITIES[key]
+            parts.append(f"U({q.label}) ≤ {max(hidden):.2g} {q.unit}"
+                         + ("" if len(hidden) == total else
+                            f" ({len(hidden)} of {total} points)"))
+    if not parts:
+        return None
+    return ("Error bars smaller than the markers: " + ", ".join(parts) + " (U: 95 % expanded "
+            "uncertainty of the mean, k·σ with σ the larger of the run's combined standard "
+            "uncertainty and its replicate spread).")
 
 
 def _curve(ax, curve, quantity: str, colour: str, ls: str = "-", lw: float = 1.6,
@@ -162,8 +204,9 @@ def _slip_axes(fig: Figure, keys) -> list:
 def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, soil: str,
                        statuses, palette: Palette) -> Figure:
     """DP, torque, sinkage and resistance against slip for one wheel on one soil: every
-    load and multipass, means with their standard errors as error bars (hollow: runs whose
-    status is not in ``statuses``, i.e. not fitted) and the fitted polynomials."""
+    load and multipass, means with their 95 % expanded uncertainty as error bars
+    (:func:`expanded_uncertainty`; hollow: runs whose status is not in ``statuses``, i.e. not
+    fitted) and the fitted polynomials."""
     fig = Figure(figsize=(11.0, 8.2), layout="constrained")
     axes = _slip_axes(fig, CURVE_QUANTITIES)
     mine = points[(points["wheel"] == wheel) & (points["soil"] == soil)]
@@ -180,8 +223,8 @@ def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, s
         handles.append(Line2D([], [], ls="", marker="o", color="0.3", mfc="white",
                               label="flagged, not fitted"))
     fig.legend(handles=handles, loc="outside right upper", title="load, soil pass")
-    fig.suptitle(f"{plain_text(wheel)} on {plain_text(soil)}: means ± standard error, "
-                 "fitted polynomials",
+    fig.suptitle(f"{plain_text(wheel)} on {plain_text(soil)}: means ± 95 % expanded "
+                 "uncertainty, fitted polynomials",
                  fontsize="medium")
     return fig
 
@@ -189,8 +232,8 @@ def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, s
 def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, load_n: float,
                     checks: list[ValidationResult], palette: Palette) -> Figure:
     """The curves at the tested loads interpolated to ``load_n`` (thick) against the runs at
-    ``load_n`` kept aside (points ± standard error), one panel per quantity, the RMSE as %
-    of the measured range in each title."""
+    ``load_n`` kept aside (points ± 95 % expanded uncertainty), one panel per quantity, the
+    RMSE as % of the measured range in each title."""
     fig = Figure(figsize=(11.0, 8.2), layout="constrained")
     axes = _slip_axes(fig, CURVE_QUANTITIES)
     by_quantity = {c.quantity: c for c in checks}
