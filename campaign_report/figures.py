@@ -7,6 +7,7 @@ from __future__ import annotations
 import textwrap
 import warnings
 
+import matplotlib
 import numpy as np
 import pandas as pd
 from matplotlib.container import ErrorbarContainer
@@ -54,10 +55,14 @@ class RunTimeseries:
         self.palette = palette
         # fixed margins: constrained layout would double the cost
         self.figure = Figure(figsize=(8.0, 6.4))
-        self.axes = self.figure.subplots(len(TRACE_QUANTITIES), 1, sharex=True)
+        # one time range set on all four (sharex would make each axis measure the tick
+        # labels of the others at every draw)
+        self.axes = self.figure.subplots(len(TRACE_QUANTITIES), 1)
         for ax, key in zip(self.axes, TRACE_QUANTITIES):
             ax.set_ylabel(QUANTITIES[key].axis_label)
             ax.grid(alpha=0.3)
+            if ax is not self.axes[-1]:
+                ax.tick_params(labelbottom=False)
         self.axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
         self.title = self.figure.suptitle("", fontsize="medium")
         self._drawn: list = []  # the artists of the run drawn last
@@ -70,6 +75,15 @@ class RunTimeseries:
         for ax in self.axes:
             ax.relim()  # no data left: limits from this run's artists only
             ax.set_autoscale_on(True)
+
+    def _time_range(self) -> None:
+        """The time span of the run's artists on all four axes, with the default margins."""
+        spans = [ax.dataLim.intervalx for ax in self.axes
+                 if np.isfinite(ax.dataLim.intervalx).all()]
+        lo, hi = (min(s[0] for s in spans), max(s[1] for s in spans)) if spans else (0.0, 1.0)
+        pad = matplotlib.rcParams["axes.xmargin"] * (hi - lo) if hi > lo else 0.5
+        for ax in self.axes:
+            ax.set_xlim(lo - pad, hi + pad)
 
     def _legend(self, colour: str) -> None:
         labelled = {}
@@ -118,6 +132,7 @@ class RunTimeseries:
                 y_data = True
             if not y_data:
                 ax.set_ylim(0.0, 1.0)
+        self._time_range()
         self._legend(colour)
         title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass "
                  f"{run.multipass}" + (f", slip set {100 * run.slip_setpoint:g} %"

@@ -44,11 +44,12 @@ _CHUNK = 8192  # colours per distance block (8192 x 256 float32: 8 MiB)
 
 @dataclass(frozen=True)
 class Rendered:
-    """A figure's pixels (RGBA, opaque) and its palette (colour keys, white first; None: not
-    a plot, quantised by median cut)."""
+    """A figure's pixels (RGBA, opaque), its palette (colour keys, white first; None: not a
+    plot, quantised by median cut) and its colours other than white (sorted keys)."""
 
     rgba: np.ndarray
     palette: np.ndarray | None
+    colours: np.ndarray
 
 
 def _key(colour: str) -> int:
@@ -65,23 +66,27 @@ def _rgb(keys: np.ndarray) -> np.ndarray:
     return np.stack([keys & 255, (keys >> 8) & 255, keys >> 16], axis=1).astype(np.float32)
 
 
-def _palette(keys: np.ndarray) -> np.ndarray | None:
+def _palette(keys: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
     """White, the colours of :data:`EXACT` present, then the most frequent others
-    (:data:`PALETTE_SIZE` in all); None when the image is not a plot."""
+    (:data:`PALETTE_SIZE` in all; None when the image is not a plot), and the image's
+    colours other than white."""
     colours, counts = np.unique(keys[keys != WHITE_KEY], return_counts=True)
     order = np.argsort(-counts, kind="stable")
     if counts[order[:PALETTE_SIZE - 1]].sum() + (keys.size - counts.sum()) \
             < PLOT_COVERAGE * keys.size:
-        return None
+        return None, colours
     present = set(colours.tolist())
     exact = [k for c in EXACT if (k := _key(c)) == WHITE_KEY or k in present]
     chosen = dict.fromkeys(exact + colours[order][:PALETTE_SIZE].tolist())
-    return np.fromiter(chosen, np.uint32)[:PALETTE_SIZE]
+    return np.fromiter(chosen, np.uint32)[:PALETTE_SIZE], colours
 
 
-def _indices(keys: np.ndarray, palette: np.ndarray) -> np.ndarray:
-    """Each pixel's nearest palette index (uint8)."""
-    colours = np.unique(keys[keys != WHITE_KEY])
+def _indices(keys: np.ndarray, palette: np.ndarray, colours: np.ndarray | None = None
+             ) -> np.ndarray:
+    """Each pixel's nearest palette index (uint8); ``colours``: the image's colours other
+    than white, if known."""
+    if colours is None:
+        colours = np.unique(keys[keys != WHITE_KEY])
     p = _rgb(palette)
     p_sq = (p * p).sum(axis=1)
     for start in range(0, colours.size, _CHUNK):
@@ -92,14 +97,17 @@ def _indices(keys: np.ndarray, palette: np.ndarray) -> np.ndarray:
     return _INDEX[keys]
 
 
-def encode(rgba: np.ndarray, palette: np.ndarray | None) -> bytes:
+def encode(rgba: np.ndarray, palette: np.ndarray | None,
+           colours: np.ndarray | None = None) -> bytes:
     """An (h, w, 4) image as a PNG of ``palette``'s colours (nearest colour, no dithering);
-    ``None``: of its median-cut colours."""
+    ``None``: of its median-cut colours. ``colours``: the image's colours other than white,
+    if known."""
     if palette is None:
         image = Image.fromarray(rgba[..., :3]).quantize(MEDIAN_CUT_COLOURS,
                                                         method=Image.Quantize.MEDIANCUT)
     else:
-        image = Image.fromarray(_indices(_keys(rgba), palette).reshape(rgba.shape[:2]), "P")
+        image = Image.fromarray(_indices(_keys(rgba), palette, colours).reshape(rgba.shape[:2]),
+                                "P")
         image.putpalette(_rgb(palette).astype(np.uint8).ravel().tolist())
     out = io.BytesIO()
     image.save(out, format="PNG")
@@ -115,19 +123,20 @@ def render(fig: Figure, dpi: int = FULL_DPI) -> Rendered:
     fig.patch.set_facecolor("white")
     canvas.draw()
     rgba = np.array(canvas.buffer_rgba(), copy=True)
-    return Rendered(rgba, _palette(_keys(rgba)))
+    return Rendered(rgba, *_palette(_keys(rgba)))
 
 
 def to_png(fig: Figure, dpi: int = FULL_DPI) -> tuple[bytes, Rendered]:
     """The figure as a palette PNG, and its pixels and palette (for :func:`thumbnail`)."""
     rendered = render(fig, dpi)
-    return encode(rendered.rgba, rendered.palette), rendered
+    return encode(rendered.rgba, rendered.palette, rendered.colours), rendered
 
 
 def thumbnail(rendered: Rendered, width: int = THUMB_WIDTH_PX) -> bytes:
-    """The figure scaled down to ``width`` pixels wide (aspect kept, Lanczos), as a PNG of
-    the full figure's palette (median cut of its own if the figure is not a plot)."""
+    """The figure scaled down to ``width`` pixels wide (aspect kept; Hamming filter: a
+    third of Lanczos' cost), as a PNG of the full figure's palette (median cut of its own if
+    the figure is not a plot)."""
     h, w = rendered.rgba.shape[:2]
-    small = Image.fromarray(rendered.rgba, "RGBA").resize(
-        (width, max(1, round(h * width / w))), Image.Resampling.LANCZOS)
+    small = Image.fromarray(rendered.rgba, "RGBA").convert("RGB").resize(
+        (width, max(1, round(h * width / w))), Image.Resampling.HAMMING).convert("RGBA")
     return encode(np.asarray(small), rendered.palette)

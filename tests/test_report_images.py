@@ -32,7 +32,7 @@ def test_a_few_colours_are_encoded_losslessly_and_others_take_the_nearest():
     rgb[5:15, :] = (0x00, 0x72, 0xB2)       # a load colour
     rgb[20:30, :] = (200, 10, 10)           # a colour of the figure's own
     rgb[35, 3] = (2, 112, 180)              # one rare pixel, nearest to the load colour
-    rendered = images.Rendered(_rgba(rgb), images._palette(images._keys(_rgba(rgb))))
+    rendered = images.Rendered(_rgba(rgb), *images._palette(images._keys(_rgba(rgb))))
     out = _decoded(images.encode(rendered.rgba, rendered.palette))
     expected = rgb.copy()
     # by hand: the rare pixel (2, 112, 180) is in the palette too (<= 256 colours): kept
@@ -48,7 +48,7 @@ def test_a_few_colours_are_encoded_losslessly_and_others_take_the_nearest():
 def test_a_non_plot_is_quantised_by_median_cut():
     rng = np.random.default_rng(3)
     rgb = rng.integers(0, 256, (64, 64, 3), dtype=np.uint8)  # noise: no colour is frequent
-    assert images._palette(images._keys(_rgba(rgb))) is None
+    assert images._palette(images._keys(_rgba(rgb)))[0] is None
     out = _decoded(images.encode(_rgba(rgb), None))
     assert out.shape == rgb.shape and np.abs(out.astype(int) - rgb).mean() < 40
 
