@@ -10,7 +10,8 @@ core (``os.sched_setaffinity``):
   of 2,000 points each, ``savefig`` to PNG: the least a page of 60 time-series figures costs
   when each figure is drawn anew.
 
-Printed: both in seconds (wall and CPU of the child), their ratio, the page's size, and the
+Printed: both in seconds (wall and CPU of the child; the fastest of :data:`REPEATS`
+interleaved runs of each), their ratio, the page's size, and the
 report's phases measured in this process (gathering from the database, the time-series
 figures, the other sections, the HTML). Issue 19 item 5: the report in 8 s or less.
 """
@@ -32,6 +33,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "sample_data" / "campaign"
 QUICK_RUNS = 12
+REPEATS = 2
 
 BASELINE = """
 import io, sys
@@ -52,7 +54,7 @@ def _one_core() -> None:
     os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
 
 
-def _child(argv: list[str]) -> tuple[float, float]:
+def _child_once(argv: list[str]) -> tuple[float, float]:
     """(wall s, CPU s) of a child process pinned to one core."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
@@ -117,10 +119,14 @@ def main(quick: bool = False, db: str | None = None) -> dict:
         phases = _phases(db)
         runs = phases.pop("runs")
         page = folder / "page.html"
-        report = _child([sys.executable, "-m", "swtlab_cli.main", "report", "--db", db, "-o",
-                         str(page), "--quiet"])
+        report_argv = [sys.executable, "-m", "swtlab_cli.main", "report", "--db", db, "-o",
+                       str(page), "--quiet"]
+        baseline_argv = [sys.executable, "-c", BASELINE.format(runs=runs)]
+        measured = [(_child_once(report_argv), _child_once(baseline_argv))
+                    for _ in range(REPEATS)]  # interleaved: both see the same load
+        report = tuple(min(m[0][i] for m in measured) for i in (0, 1))
+        baseline = tuple(min(m[1][i] for m in measured) for i in (0, 1))
         size_mb = page.stat().st_size / 1e6
-        baseline = _child([sys.executable, "-c", BASELINE.format(runs=runs)])
     ratio, cpu_ratio = report[0] / baseline[0], report[1] / baseline[1]
     print(f"report of {runs} runs on one core: {report[0]:.2f} s wall, {report[1]:.2f} s CPU, "
           f"page {size_mb:.1f} MB (issue 19.5: <= 8 s)")
