@@ -7,6 +7,7 @@ Method after RUAG's Wheel Parametric Analytical Tool (WPAT) and Wheel Performanc
 (WPM). Pure functions on tables and arrays; see docs/fitting.md.
 """
 
+from fitting.band import band
 from fitting.curve import DEGREES, QUANTITY_UNITS, CurveFit, PowerCurve
 from fitting.errors import (DegreeError, FittingError, LoadExtrapolationWarning, LoadRangeError,
                             OutsideSlipRangeWarning, TooFewPointsError)
@@ -17,7 +18,7 @@ from fitting.table import (curves_by_load, fit_results, from_run_results, quanti
 from fitting.validation import ValidationResult, validate_load_interpolation
 
 __all__ = [
-    "DEGREES", "QUANTITY_UNITS", "CurveFit", "DegreeError", "FittingError", "InterpolatedCurve",
+    "DEGREES", "QUANTITY_UNITS", "band", "CurveFit", "DegreeError", "FittingError", "InterpolatedCurve",
     "LoadCurves", "LoadExtrapolationWarning", "LoadRangeError", "OutsideSlipRangeWarning",
     "PowerCurve", "TooFewPointsError", "ValidationResult", "curves_by_load", "fit_curve",
     "fit_results", "from_run_results", "interpolate_load", "interpolate_loads", "quantities_in",

@@ -23,13 +23,19 @@ DEGREES = range(3, 8)  # RUAG WPAT: "polynomials of degrees n = 3 ... 7 provide 
 class PowerCurve:
     """``sum_i a_i slip**i + [slip < 0] (J + K slip)`` (``coefficients[i] = a_i``, ``J`` =
     ``step_below_zero``, ``K`` = ``slope_below_zero``, both 0 for a plain polynomial) valid
-    on [slip_min, slip_max]."""
+    on [slip_min, slip_max]. Its uncertainty (docs/fitting.md, "Bands"; None / NaN where
+    unknown): ``covariance`` of the parameters ``(a_0 ... a_n, J, K)`` (rows), ``scatter_sd``
+    the run-to-run standard deviation of one run's mean about the curve, ``k95`` the factor
+    of the 95 % half-widths (:func:`fitting.band.band`)."""
 
     coefficients: tuple[float, ...]
     slip_min: float
     slip_max: float
     step_below_zero: float = field(default=0.0, kw_only=True)
     slope_below_zero: float = field(default=0.0, kw_only=True)
+    covariance: tuple[tuple[float, ...], ...] | None = field(default=None, kw_only=True)
+    scatter_sd: float = field(default=float("nan"), kw_only=True)
+    k95: float = field(default=float("nan"), kw_only=True)
 
     @property
     def degree(self) -> int:
@@ -95,6 +101,8 @@ class CurveFit(PowerCurve):
     def to_dict(self) -> dict:
         out = asdict(self)
         out["coefficients"] = list(self.coefficients)
+        out["covariance"] = None if self.covariance is None else [list(r) for r in
+                                                                  self.covariance]
         out["degree"] = self.degree
         out["degree_scores"] = {str(d): s for d, s in self.degree_scores}
         out["branch_scores"] = {f"{d}+{b}": s for d, b, s in self.branch_scores}

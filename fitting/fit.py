@@ -16,6 +16,7 @@ way), with step and slope by 0.67 % and 0.69 % (docs/fitting.md, "The join at ze
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import t as student_t
 
 from fitting.curve import DEGREES, QUANTITY_UNITS, CurveFit
 from fitting.degree import (CRITERIA, branch_fits, branch_loo_residuals, candidate_degrees,
@@ -23,6 +24,8 @@ from fitting.degree import (CRITERIA, branch_fits, branch_loo_residuals, candida
 from fitting.errors import DegreeError, FittingError, TooFewPointsError
 from fitting.oscillation import check_oscillation
 from fitting.polynomial import BRANCH_TERMS, weighted_lstsq
+
+Z95 = 1.959963984540054  # two-sided 95 % normal quantile
 
 SE_FLOOR_FRACTION = 0.2  # SE floored at this fraction of the median SE: weight <= 25x median
 
@@ -107,6 +110,8 @@ def fit_curve(slip, value, se=None, *, degree: int | str = "loo", branch: int | 
     mean_w = np.sum(weights * value) / np.sum(weights)
     total = np.sum(weights * (value - mean_w) ** 2)
     step_se, slope_se = _branch_se(ls, resid, weights, weighting.startswith("1/SE^2"))
+    covariance, scatter_sd, k95 = fit_uncertainty(ls, resid, weights,
+                                                  weighting.startswith("1/SE^2"))
     return CurveFit(
         coefficients=tuple(float(a) for a in ls.coefficients), slip_min=lo, slip_max=hi,
         step_below_zero=float(ls.below_zero[0]), slope_below_zero=float(ls.below_zero[1]),
@@ -122,7 +127,8 @@ def fit_curve(slip, value, se=None, *, degree: int | str = "loo", branch: int | 
         weighting=weighting, oscillates=oscillates, max_departure=departure,
         branch_choice="user" if isinstance(branch, int) else criterion,
         branch_scores=tuple((d, b, float(v[0])) for (d, b), v in sorted(scores.items()) if b),
-        step_se=step_se, slope_se=slope_se)
+        step_se=step_se, slope_se=slope_se, covariance=covariance, scatter_sd=scatter_sd,
+        k95=k95)
 
 
 def _candidates(degrees: list[int], branch: int | str, slip: np.ndarray, spare: int,
@@ -152,3 +158,25 @@ def _branch_se(ls, resid: np.ndarray, weights: np.ndarray, from_se: bool) -> tup
         else float("nan")
     step_se, slope_se = ls.below_zero_se * np.sqrt(scale)
     return float(step_se), float(slope_se)
+
+
+def fit_uncertainty(ls, resid: np.ndarray, weights: np.ndarray, from_se: bool
+                    ) -> tuple[tuple[tuple[float, ...], ...], float, float]:
+    """(covariance of ``(a_0 ... a_n, J, K)``, run-to-run SD, 95 % factor) of a fit
+    (docs/fitting.md, "Bands"). With weights 1/sigma^2: ``(X^T W X)^-1`` times the Birge
+    ratio ``max(1, chi^2/dof)`` (Birge 1932, Phys. Rev. 40:207; the Particle Data Group's
+    scale factor), scatter the RMS sigma times its root, factor 1.96 when the ratio is <= 1
+    (the sigmas are trusted) else Student's t(0.975, dof). Without sigmas: scaled by
+    ``WRSS/dof``, scatter its root, factor t(0.975, dof)."""
+    dof = resid.size - ls.n_parameters
+    ratio = float(np.sum(weights * resid ** 2)) / dof if dof > 0 else float("nan")
+    if from_se:
+        trusted = not ratio > 1.0  # NaN (no dof): the sigmas alone
+        scale = 1.0 if trusted else ratio
+        scatter = float(np.sqrt(scale * np.mean(1.0 / weights)))
+    else:
+        trusted, scale = False, ratio
+        scatter = float(np.sqrt(ratio))
+    k95 = Z95 if trusted else float(student_t.ppf(0.975, dof)) if dof > 0 else float("nan")
+    covariance = ls.covariance * scale
+    return tuple(tuple(float(v) for v in row) for row in covariance), scatter, k95

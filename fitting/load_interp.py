@@ -28,7 +28,8 @@ from scipy.interpolate import PchipInterpolator
 
 from fitting.curve import DEGREES, PowerCurve
 from fitting.errors import DegreeError, LoadExtrapolationWarning, LoadRangeError
-from fitting.polynomial import branch_design, branch_from_solution, curve_value, lobatto_grid
+from fitting.polynomial import (branch_design, branch_from_solution, curve_value, lobatto_grid,
+                                parameter_gradient, solution_to_parameters)
 
 GRID_POINTS = 101
 METHODS = ("auto", "linear", "pchip")
@@ -38,7 +39,8 @@ METHODS = ("auto", "linear", "pchip")
 class InterpolatedCurve(PowerCurve):
     """The curve at ``load_n``; ``fit_rmse`` is the RMS misfit of its polynomial to the
     interpolated grid values (0 to rounding for linear interpolation: a weighted sum of
-    polynomials is one)."""
+    polynomials is one). Its covariance is the tested curves' propagated through the
+    interpolation, its ``scatter_sd`` and ``k95`` linear across load between theirs."""
 
     load_n: float
     method: str
@@ -64,6 +66,9 @@ class LoadCurves:
     tested_loads_n: tuple[float, ...]
     extrapolated: np.ndarray
     fit_rmse: np.ndarray
+    covariance: np.ndarray | None = None
+    scatter_sd: np.ndarray | None = None
+    k95: np.ndarray | None = None
 
     def curve(self, i: int) -> InterpolatedCurve:
         return InterpolatedCurve(
@@ -72,7 +77,11 @@ class LoadCurves:
             slope_below_zero=float(self.below_zero[i, 1]), load_n=float(self.loads_n[i]),
             method=self.method,
             tested_loads_n=self.tested_loads_n, extrapolated=bool(self.extrapolated[i]),
-            fit_rmse=float(self.fit_rmse[i]))
+            fit_rmse=float(self.fit_rmse[i]),
+            covariance=None if self.covariance is None
+            else tuple(tuple(float(v) for v in row) for row in self.covariance[i]),
+            scatter_sd=float("nan") if self.scatter_sd is None else float(self.scatter_sd[i]),
+            k95=float("nan") if self.k95 is None else float(self.k95[i]))
 
 
 def _check_loads(tested: np.ndarray, query: np.ndarray, allow_extrapolation: bool) -> np.ndarray:
@@ -126,9 +135,11 @@ def branch_terms(curve: PowerCurve) -> int:
 
 def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: str = "auto",
                       degree: int | None = None, allow_extrapolation: bool = False,
-                      grid_points: int = GRID_POINTS) -> LoadCurves:
+                      grid_points: int = GRID_POINTS, uncertainty: bool = True) -> LoadCurves:
     """Curves at every load of ``loads_n`` from ``curves`` (tested load in N -> curve of one
     quantity). ``degree``: of the fitted result, default the highest tested degree.
+    ``uncertainty``: carry the tested curves' covariance through (:func:`_propagate`) when
+    every one has it.
     Raises :class:`LoadRangeError` (load outside the tested ones without
     ``allow_extrapolation``, no common slip range) or :class:`DegreeError`."""
     if method not in METHODS:
@@ -151,10 +162,46 @@ def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: st
                           query, method, outside)
     coefficients, below = branch_from_solution(values @ projection, lo, hi, degree)
     misfit = curve_value(coefficients[:, None, :], grid, below[:, :1], below[:, 1:]) - values
+    known = uncertainty and all(c.covariance is not None for c in ordered)
+    covariance = _propagate(ordered, tested, query, method, outside, grid,
+                            projection @ solution_to_parameters(lo, hi, degree,
+                                                                projection.shape[1])) \
+        if known else None
     return LoadCurves(loads_n=query, coefficients=coefficients, below_zero=below,
                       slip_min=lo, slip_max=hi,
                       method=method, tested_loads_n=tuple(tested.tolist()), extrapolated=outside,
-                      fit_rmse=np.sqrt(np.mean(misfit ** 2, axis=1)))
+                      fit_rmse=np.sqrt(np.mean(misfit ** 2, axis=1)), covariance=covariance,
+                      **(_linear_in_load(ordered, tested, query, outside) if known else {}))
+
+
+def _linear_in_load(ordered: list[PowerCurve], tested: np.ndarray, query: np.ndarray,
+                    outside: np.ndarray) -> dict[str, np.ndarray]:
+    """``scatter_sd`` and ``k95`` at the query loads: linear across load between the tested
+    curves' (a property of the rig at that load, not of one curve)."""
+    both = np.array([[c.scatter_sd, c.k95] for c in ordered])
+    out = _across_load(tested, both, query, "linear", outside)
+    return {"scatter_sd": np.maximum(out[:, 0], 0.0), "k95": np.maximum(out[:, 1], 0.0)}
+
+
+def _propagate(ordered: list[PowerCurve], tested: np.ndarray, query: np.ndarray, method: str,
+               outside: np.ndarray, grid: np.ndarray, to_theta: np.ndarray) -> np.ndarray:
+    """Covariance (queries x p x p) of the interpolated curves' parameters: the tested curves
+    are independent (different runs), the across-load step is linearised (its sensitivity
+    to each tested curve's grid values by a forward difference: PCHIP's slopes depend on the
+    values; exact for linear), the refit is linear (``to_theta``: grid values -> theta)."""
+    values = np.array([curve_value(c.coefficients, grid, c.step_below_zero, c.slope_below_zero)
+                       for c in ordered])
+    base = _across_load(tested, values, query, method, outside)
+    delta = 1e-6 * max(float(np.ptp(values)), float(np.max(np.abs(values))), 1e-300)
+    out = 0.0
+    for k, c in enumerate(ordered):
+        bumped = values.copy()
+        bumped[k] += delta
+        sensitivity = (_across_load(tested, bumped, query, method, outside) - base) / delta
+        design = parameter_gradient(grid, c.degree)  # grid x p_k
+        mapped = np.einsum("qg,gi,gj->qij", sensitivity, design, to_theta)  # q x p_k x p
+        out = out + np.einsum("qia,ij,qjb->qab", mapped, np.asarray(c.covariance), mapped)
+    return out
 
 
 def interpolate_load(curves: Mapping[float, PowerCurve], load_n: float,

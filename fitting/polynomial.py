@@ -115,8 +115,10 @@ class LeastSquares:
     """One weighted least-squares solve: power coefficients, the braked branch ``(J, K)``
     (``branch`` of them fitted, the others 0) and their standard-error factors
     ``sqrt([(X^T W X)^-1]_kk)`` (NaN where not fitted), fitted values at the points,
-    leverages (diagonal of the hat matrix) and the 2-norm condition number of the weighted
-    design matrix that was solved."""
+    leverages (diagonal of the hat matrix), the 2-norm condition number of the weighted
+    design matrix that was solved, and ``covariance``: ``(X^T W X)^-1`` of the parameters
+    ``(a_0 ... a_n, J, K)`` (:func:`parameter_gradient`; zero rows for terms not fitted),
+    unscaled (the covariance when the weights are 1/sigma^2)."""
 
     coefficients: np.ndarray
     branch: int
@@ -125,6 +127,7 @@ class LeastSquares:
     fitted: np.ndarray
     leverage: np.ndarray
     condition_number: float
+    covariance: np.ndarray
 
     @property
     def n_parameters(self) -> int:
@@ -147,10 +150,32 @@ def weighted_lstsq(slip, value, weights, degree: int, slip_min: float,
     se = np.full(2, np.nan)
     se[:branch] = factor * np.array([1.0, 1.0 / _braked_span(slip_min)])[:branch]
     singular = np.linalg.svd(r, compute_uv=False)
+    to_parameters = solution_to_parameters(float(slip_min), float(slip_max), degree,
+                                           design.shape[1])
+    r_inv_t = np.linalg.inv(r).T @ to_parameters  # Cov(solution) = R^-1 R^-T
     return LeastSquares(coefficients=coefficients, branch=branch, below_zero=below,
                         below_zero_se=se, fitted=curve_value(coefficients, slip, *below),
                         leverage=np.sum(q * q, axis=1),
-                        condition_number=float(singular[0] / singular[-1]))
+                        condition_number=float(singular[0] / singular[-1]),
+                        covariance=r_inv_t.T @ r_inv_t)
+
+
+def solution_to_parameters(slip_min: float, slip_max: float, degree: int,
+                           n_solution: int) -> np.ndarray:
+    """Matrix ``T`` (n_solution x degree + 3) with ``theta = solution @ T``: a
+    :func:`branch_design` solution (Chebyshev coefficients, then branch terms) to the
+    parameters ``(a_0 ... a_n, J, K)`` (linear: :func:`branch_from_solution` of the unit
+    vectors)."""
+    coefficients, branch = branch_from_solution(np.eye(n_solution), slip_min, slip_max, degree)
+    return np.hstack([coefficients, branch])
+
+
+def parameter_gradient(slip, degree: int) -> np.ndarray:
+    """``g(s) = (1, s, ..., s**n, [s < 0], [s < 0] s)`` along the last axis: the curve's
+    derivative by its parameters ``(a_0 ... a_n, J, K)`` (the curve is linear in them)."""
+    s = np.asarray(slip, dtype=float)[..., None]
+    below = (s < 0).astype(float)
+    return np.concatenate([s ** np.arange(degree + 1), below, below * s], axis=-1)
 
 
 def lobatto_grid(slip_min: float, slip_max: float, n: int) -> np.ndarray:

@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
+from fitting.band import band
 from fitting.errors import FittingError, OutsideSlipRangeWarning
 from fitting.load_interp import interpolate_load
 from fitting.table import KEY_COLUMNS, curves_by_load, fit_results, with_dp_over_w
@@ -27,6 +28,9 @@ class ValidationResult:
     others would be extrapolated in slip: counted in ``n_outside_slip_range``, included only in
     ``rmse_all``); ``rmse_pct_of_range`` = 100 x ``rmse`` / range of the measured values
     (for ``dp_n`` the literature's figure: % of the measured DP range).
+    ``n_inside_band`` of the ``n_points - n_outside_slip_range`` points inside the slip range
+    lie within the interpolated curve's 95 % prediction band (:func:`fitting.band.band`);
+    ``fraction_inside_band`` is that share (NaN without points or without uncertainty).
     """
 
     wheel: str
@@ -43,6 +47,8 @@ class ValidationResult:
     rmse_pct_of_range: float
     max_abs_error: float
     rmse_all: float
+    n_inside_band: int = 0
+    fraction_inside_band: float = float("nan")
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -78,6 +84,9 @@ def validate_load_interpolation(results_table: pd.DataFrame, validation_load_n: 
                 warnings.simplefilter("ignore", OutsideSlipRangeWarning)
                 error = curve.evaluate(slip) - value
             inside = ~curve.outside_range(slip)
+            _, _, pred_half95 = band(curve, slip)
+            in_band = inside & (np.abs(error) <= pred_half95)
+            known = inside.any() and bool(np.all(np.isfinite(pred_half95[inside])))
             rmse = float(np.sqrt(np.mean(error[inside] ** 2))) if inside.any() else float("nan")
             spread = float(np.ptp(value)) if value.size else float("nan")
             out.append(ValidationResult(
@@ -88,5 +97,8 @@ def validate_load_interpolation(results_table: pd.DataFrame, validation_load_n: 
                 rmse_pct_of_range=100.0 * rmse / spread if spread > 0 else float("nan"),
                 max_abs_error=float(np.max(np.abs(error[inside]))) if inside.any()
                 else float("nan"),
-                rmse_all=float(np.sqrt(np.mean(error ** 2))) if error.size else float("nan")))
+                rmse_all=float(np.sqrt(np.mean(error ** 2))) if error.size else float("nan"),
+                n_inside_band=int(in_band.sum()),
+                fraction_inside_band=float(in_band.sum() / inside.sum()) if known
+                else float("nan")))
     return out
