@@ -210,7 +210,12 @@ def _from_export(row, latest_ids: set[int], campaign_ids: set[int]
             weighting=d["weighting"], oscillates=d["oscillates"],
             max_departure=d["max_departure"],
             step_below_zero=d.get("step_below_zero", 0.0),  # stored fits before the branch: 0
-            slope_below_zero=d.get("slope_below_zero", 0.0)))
+            slope_below_zero=d.get("slope_below_zero", 0.0),
+            # the bands' inputs where the store keeps them (else unknown: no band)
+            covariance=None if d.get("covariance") is None
+            else tuple(tuple(float(v) for v in row) for row in d["covariance"]),
+            scatter_sd=float(d.get("scatter_sd", float("nan"))),
+            k95=float(d.get("k95", float("nan")))))
     options = row.processing.parameters or {}
     stale = any(r.id not in latest_ids for f in mine for r in f.inputs)
     source = CurveSource(export_path=row.path, file_sha256=row.file_sha256,

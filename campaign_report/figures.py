@@ -13,11 +13,12 @@ import pandas as pd
 from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from campaign_report.data import RunRecord, SetKey
 from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
                                    plain_text)
-from fitting import CurveFit, ValidationResult, curves_by_load, interpolate_load
+from fitting import CurveFit, ValidationResult, band, curves_by_load, interpolate_load
 from run_results.traces import TRACE_QUANTITIES
 from sim_gap.vocabulary import SLIP_BAND_EDGES, slip_band_labels
 from wpm_export import WheelPerformanceModule
@@ -206,6 +207,47 @@ def _curve(ax, curve, quantity: str, colour: str, ls: str = "-", lw: float = 1.6
             ls=ls, lw=lw, alpha=alpha)
 
 
+def _bands(ax, curve, quantity: str, colour: str) -> bool:
+    """A curve's 95 % confidence band (darker) and prediction band (lighter) shaded over its
+    slip range (``fitting.band``, docs/fitting.md "Bands"); False, nothing drawn, where the
+    curve carries no uncertainty."""
+    slip = np.linspace(curve.slip_min, curve.slip_max, CURVE_POINTS)
+    mean, conf, pred = band(curve, slip)
+    if not np.isfinite(pred).any():
+        return False
+    scale = QUANTITIES[quantity].scale
+    for half, alpha in ((pred, 0.08), (conf, 0.22)):
+        ax.fill_between(slip * 100.0, (mean - half) * scale, (mean + half) * scale,
+                        color=colour, alpha=alpha, lw=0, zorder=1)
+    return True
+
+
+def band_text(curves, keys) -> str:
+    """The largest 95 % half-widths of the curves' bands per quantity of ``keys``, in words
+    (the bands can be narrower than a curve's line); or that the curves carry none."""
+    parts = []
+    for key in keys:
+        widths = [np.nanmax(np.stack(band(c, np.linspace(c.slip_min, c.slip_max,
+                                                          CURVE_POINTS))[1:]), axis=1)
+                  for c in curves if c.quantity == key and c.covariance is not None]
+        if widths:
+            q = QUANTITIES[key]
+            conf, pred = np.nanmax(widths, axis=0) * q.scale
+            parts.append(f"{q.label} ± {conf:.2g} / ± {pred:.2g} {q.unit}")
+    if not parts:
+        return ("These curves carry no uncertainty (stored without their parameter "
+                "covariance): no bands drawn.")
+    return ("95 % bands (fitting.band: confidence, where the true curve lies / prediction, "
+            "where one new run's mean lies), their largest half-widths: " + ", ".join(parts)
+            + ".")
+
+
+def band_handles() -> list[Patch]:
+    """Legend entries of the two bands (:func:`_bands`)."""
+    return [Patch(color="0.3", alpha=0.22 + 0.08, label="95 % confidence band"),
+            Patch(color="0.3", alpha=0.08, label="95 % prediction band")]
+
+
 def _slip_axes(fig: Figure, keys) -> list:
     axes = fig.subplots(2, (len(keys) + 1) // 2, squeeze=False).ravel()
     for ax, key in zip(axes, keys):
@@ -221,10 +263,11 @@ def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, s
     """DP, torque, sinkage and resistance against slip for one wheel on one soil: every
     load and multipass, means with their 95 % expanded uncertainty as error bars
     (:func:`expanded_uncertainty`; hollow: runs whose status is not in ``statuses``, i.e. not
-    fitted) and the fitted polynomials."""
+    fitted) and the fitted polynomials with their 95 % confidence and prediction bands."""
     fig = Figure(figsize=(11.0, 8.2), layout="constrained")
     axes = _slip_axes(fig, CURVE_QUANTITIES)
     mine = points[(points["wheel"] == wheel) & (points["soil"] == soil)]
+    banded = False
     for ax, key in zip(axes, CURVE_QUANTITIES):
         for (mp, load), rows in mine.groupby(["multipass", "load_n"]):
             rows = rows[np.isfinite(rows[key].astype(float))]
@@ -233,22 +276,25 @@ def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, s
         for f in fits:
             if (f.wheel, f.soil, f.quantity) == (wheel, soil, key):
                 _curve(ax, f, key, palette.colour(f.load_n), palette.line(f.multipass))
+                banded |= _bands(ax, f, key, palette.colour(f.load_n))
     handles = palette.legend_handles(mine["load_n"], mine["multipass"])
+    if banded:
+        handles += band_handles()
     if not mine["status"].isin(list(statuses)).all():
         handles.append(Line2D([], [], ls="", marker="o", color="0.3", mfc="white",
                               label="flagged, not fitted"))
     fig.legend(handles=handles, loc="outside right upper", title="load, soil pass")
-    fig.suptitle(f"{plain_text(wheel)} on {plain_text(soil)}: means ± 95 % expanded "
-                 "uncertainty, fitted polynomials",
+    fig.suptitle(f"{plain_text(wheel)} on {plain_text(soil)}: means ± U95, fitted "
+                 "polynomials with their 95 % bands",
                  fontsize="medium")
     return fig
 
 
 def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, load_n: float,
                     checks: list[ValidationResult], palette: Palette) -> Figure:
-    """The curves at the tested loads interpolated to ``load_n`` (thick) against the runs at
-    ``load_n`` kept aside (points ± 95 % expanded uncertainty), one panel per quantity, the
-    RMSE as % of the measured range in each title."""
+    """The curves at the tested loads interpolated to ``load_n`` (thick, with its bands)
+    against the runs at ``load_n`` kept aside (points ± 95 % expanded uncertainty), one panel
+    per quantity, the RMSE as % of the measured range in each title."""
     fig = Figure(figsize=(11.0, 8.2), layout="constrained")
     axes = _slip_axes(fig, CURVE_QUANTITIES)
     by_quantity = {c.quantity: c for c in checks}
@@ -256,6 +302,7 @@ def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, loa
     rows = points[(points["wheel"] == key[0]) & (points["soil"] == key[1])
                   & (points["multipass"] == key[2]) & np.isclose(points["load_n"], load_n)]
     colour, mp = palette.colour(load_n), key[2]
+    banded = False
     for ax, q in zip(axes, CURVE_QUANTITIES):
         tested = sets.get((*key, q), {})
         for load, curve in sorted(tested.items()):
@@ -265,6 +312,7 @@ def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, loa
                 warnings.simplefilter("ignore")
                 interpolated = interpolate_load(tested, load_n)
             _curve(ax, interpolated, q, colour, palette.line(mp), lw=3.0, alpha=0.85)
+            banded |= _bands(ax, interpolated, q, colour)
         ok = rows[np.isfinite(rows[q].astype(float))]
         _errorbars(ax, ok, q, colour, palette.marker(mp), fitted=True)
         check = by_quantity.get(q)
@@ -273,7 +321,8 @@ def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, loa
             ax.set_title(f"{unit.label.capitalize()}: RMSE {check.rmse * unit.scale:.3g} "
                          f"{unit.unit} = {check.rmse_pct_of_range:.2g} % of range",
                          fontsize="medium")
-    fig.legend(handles=palette.legend_handles([*sets.get((*key, "dp_n"), {}), load_n], [mp]),
+    handles = palette.legend_handles([*sets.get((*key, "dp_n"), {}), load_n], [mp])
+    fig.legend(handles=handles + (band_handles() if banded else []),
                loc="outside right upper", title="load")
     fig.suptitle(f"{plain_text(key[0])} on {plain_text(key[1])}, multipass {mp}: curves "
                  "interpolated to "

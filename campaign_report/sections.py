@@ -150,7 +150,17 @@ def curves_section(data: CampaignData, palette: Palette) -> Section:
         blocks.append(Image(f"curves-{len(blocks)}", f"{wheel} on {soil}: performance curves",
                             to_png(fig)[0]))
         blocks += _errorbar_note(fig)
+        blocks.append(Note(figures.band_text(
+            [f for f in data.fits if (f.wheel, f.soil) == (wheel, soil)], CURVE_QUANTITIES)))
     return Section(CURVES, "Performance curves", blocks)
+
+
+def _inside_band(check) -> str:
+    """``k of n`` runs in the slip range inside the interpolated prediction band."""
+    n = check.n_points - check.n_outside_slip_range
+    if check.fraction_inside_band != check.fraction_inside_band:  # NaN: no band
+        return "unknown (no band)"
+    return f"{check.n_inside_band} of {n}"
 
 
 def interpolation_section(data: CampaignData, palette: Palette) -> Section | None:
@@ -159,7 +169,9 @@ def interpolation_section(data: CampaignData, palette: Palette) -> Section | Non
         return None
     blocks: list = [Note("Runs at a load with too few slips for a curve of its own, between "
                          "tested loads, check the load interpolation (RUAG WPAT's 120 N "
-                         "check): the curves at the other loads are interpolated to it.")]
+                         "check): the curves at the other loads are interpolated to it, with "
+                         "the 95 % bands propagated through the interpolation; the table "
+                         "counts the runs inside its prediction band.")]
     for key, (load, checks) in data.validation.items():
         blocks.append(Heading(f"{key[0]} on {key[1]}, multipass {key[2]}: {load:g} N"))
         fig = figures.load_validation(data.points, data.fits, key, load, checks, palette)
@@ -167,11 +179,12 @@ def interpolation_section(data: CampaignData, palette: Palette) -> Section | Non
                             to_png(fig)[0]))
         blocks += _errorbar_note(fig)
         rows = [[(q := QUANTITIES[c.quantity]).label, f"{c.rmse * q.scale:.3g} {q.unit}",
-                 f"{c.rmse_pct_of_range:.2g}", str(c.n_points), str(c.n_outside_slip_range)]
-                for c in checks]
+                 f"{c.rmse_pct_of_range:.2g}", str(c.n_points), str(c.n_outside_slip_range),
+                 _inside_band(c)] for c in checks]
         blocks.append(Table(["quantity", "RMSE", "% of measured range", "runs",
-                             "beyond the tested slips (not in RMSE)"], rows,
-                            numeric=frozenset({1, 2, 3, 4})))
+                             "beyond the tested slips (not in RMSE)",
+                             "inside the 95 % prediction band"], rows,
+                            numeric=frozenset({1, 2, 3, 4, 5})))
     return Section(INTERPOLATION, "Load interpolation check", blocks)
 
 

@@ -307,3 +307,15 @@ def test_hidden_error_bars_get_a_note_and_repeatability_follows_the_run_table(sm
     titles = re.findall(r"<h2>(.*?)</h2>", text)
     assert titles[:3] == ["Runs", "Repeatability", "Time series per run"]
     assert "This campaign has no replicate runs" in page
+
+
+def test_bands_on_the_interpolation_check_and_a_note_for_curves_without_them(small):
+    _, _, text = small
+    page = unescape(text)
+    section = page[page.index('<section id="interpolation">'):]
+    section = section[:section.index("</section>")]
+    assert "<th>inside the 95 % prediction band</th>" in section
+    inside = re.findall(r"<td class=num>(\d+) of (\d+)</td>", section)
+    assert inside and all(int(k) <= int(n) for k, n in inside)
+    # the small campaign's curves come from its export, stored without their covariance
+    assert "These curves carry no uncertainty" in page

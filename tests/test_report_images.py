@@ -1,11 +1,13 @@
 """The report's figures to PNG: palette encoding (exact where the colours fit, nearest colour
 otherwise, median cut for a non-plot), thumbnails from the same pixels, the reused
-time-series figure (a run drawn after another looks as drawn alone), and the note for error
-bars hidden by their markers (checked by hand against the axes' pixel scale)."""
+time-series figure (a run drawn after another looks as drawn alone), the note for error
+bars hidden by their markers (checked by hand against the axes' pixel scale), and the
+curves' bands (half-widths by hand from a known covariance)."""
 
 from __future__ import annotations
 
 import io
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -16,6 +18,7 @@ from PIL import Image
 from campaign_report import figures, images
 from campaign_report.data import RunRecord
 from campaign_report.style import Palette
+from fitting import PowerCurve
 from run_results.traces import TRACE_QUANTITIES, Trace
 
 
@@ -103,3 +106,28 @@ def test_error_bars_hidden_by_their_markers_are_named_with_their_size():
     ax.set_ylim(9.99, 10.01)   # now 0.02 N spans 640 px: every bar is seen
     images.render(fig)
     assert figures.hidden_errorbars(fig, ["dp_n"]) is None
+
+
+@dataclass(frozen=True)
+class _Curve(PowerCurve):
+    quantity: str = "dp_n"
+
+
+def test_bands_are_shaded_and_their_half_widths_named_by_hand():
+    # by hand: C = diag(0.3**2, 0, ...) gives g^T C g = 0.09 at every slip (g_0 = 1), so
+    # confidence = k95 * 0.3 = 0.6 N and prediction = 2 * sqrt(0.09 + 0.4**2) = 1.0 N
+    cov = np.zeros((6, 6))
+    cov[0, 0] = 0.09
+    curve = _Curve((1.0, 2.0, 0.0, 0.0), 0.0, 0.5, covariance=tuple(map(tuple, cov)),
+                   scatter_sd=0.4, k95=2.0)
+    text = figures.band_text([curve], ["dp_n"])
+    assert "drawbar pull ± 0.6 / ± 1 N" in text
+    fig = Figure()
+    ax = fig.subplots()
+    assert figures._bands(ax, curve, "dp_n", "#0072B2")
+    lows = [c.get_paths()[0].vertices[:, 1].min() for c in ax.collections]
+    # lowest edge at slip 0: mean 1.0 N minus the half-width (prediction first, confidence)
+    assert lows == pytest.approx([0.0, 0.4])
+    bare = _Curve((1.0, 2.0, 0.0, 0.0), 0.0, 0.5)
+    assert not figures._bands(ax, bare, "dp_n", "#0072B2") and len(ax.collections) == 2
+    assert "carry no uncertainty" in figures.band_text([bare], ["dp_n"])
