@@ -59,6 +59,8 @@ class RunRecord:
     dp_trace: dict | None
     traces: dict[str, Trace] | None  # None: not stored (processed before migration 0006)
     means: dict[str, float] = field(default_factory=dict)
+    #: quantity -> combined standard uncertainty of the mean (the run's budget, GUM)
+    u: dict[str, float] = field(default_factory=dict)
     #: quantity -> 95 % expanded uncertainty of the mean (the run's budget)
     u95: dict[str, float] = field(default_factory=dict)
 
@@ -76,6 +78,8 @@ class RunRecord:
                    dp_trace=result.dp_trace, traces=dict(result.traces),
                    means={k: float(q.mean) for k, q in result.quantities.items()
                           if _none_if_nan(q.mean) is not None},
+                   u={k: float(b.u) for k, b in result.uncertainty.items()
+                      if _none_if_nan(b.u) is not None},
                    u95={k: float(b.u95) for k, b in result.uncertainty.items()
                         if _none_if_nan(b.u95) is not None})
 
@@ -180,6 +184,8 @@ def _run_records(session: Session, results: pd.DataFrame) -> list[RunRecord]:
             traces=traces.get(int(row["result_id"])),
             means={c.removesuffix("_mean"): v for c in means
                    if (v := _none_if_nan(row[c])) is not None},
+            u={c.removesuffix("_u"): v for c in row
+               if c.endswith("_u") and (v := _none_if_nan(row[c])) is not None},
             u95={c.removesuffix("_u95"): v for c in row
                  if c.endswith("_u95") and (v := _none_if_nan(row[c])) is not None}))
     return runs
@@ -204,7 +210,12 @@ def _from_export(row, latest_ids: set[int], campaign_ids: set[int]
             weighting=d["weighting"], oscillates=d["oscillates"],
             max_departure=d["max_departure"],
             step_below_zero=d.get("step_below_zero", 0.0),  # stored fits before the branch: 0
-            slope_below_zero=d.get("slope_below_zero", 0.0)))
+            slope_below_zero=d.get("slope_below_zero", 0.0),
+            # the bands' inputs where the store keeps them (else unknown: no band)
+            covariance=None if d.get("covariance") is None
+            else tuple(tuple(float(v) for v in row) for row in d["covariance"]),
+            scatter_sd=float(d.get("scatter_sd", float("nan"))),
+            k95=float(d.get("k95", float("nan")))))
     options = row.processing.parameters or {}
     stale = any(r.id not in latest_ids for f in mine for r in f.inputs)
     source = CurveSource(export_path=row.path, file_sha256=row.file_sha256,

@@ -7,15 +7,18 @@ from __future__ import annotations
 import textwrap
 import warnings
 
+import matplotlib
 import numpy as np
 import pandas as pd
+from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from campaign_report.data import RunRecord, SetKey
 from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
                                    plain_text)
-from fitting import CurveFit, ValidationResult, curves_by_load, interpolate_load
+from fitting import CurveFit, ValidationResult, band, curves_by_load, interpolate_load
 from run_results.traces import TRACE_QUANTITIES
 from sim_gap.vocabulary import SLIP_BAND_EDGES, slip_band_labels
 from wpm_export import WheelPerformanceModule
@@ -24,6 +27,8 @@ from wpm_export import WheelPerformanceModule
 NOT_STORED = "trace not stored; re-run swtlab process"
 WINDOW_COLOUR = "#cfe3cf"
 CURVE_POINTS = 200
+MARKER_PT = 5.0  # marker size of the curves' points
+NORMAL_K = 1.96  # coverage factor of a 95 % interval without a budget
 
 
 def _robust_limits(ax, values: np.ndarray) -> None:
@@ -36,66 +41,162 @@ def _robust_limits(ax, values: np.ndarray) -> None:
     ax.set_ylim(lo - pad, hi + pad)
 
 
-def _no_data(ax, text: str) -> None:
-    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4",
+def _no_data(ax, text: str):
+    return ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4",
             bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85})
 
 
+class RunTimeseries:
+    """One figure of drawbar pull, torque, sinkage and slip against time, reused for every
+    run of a page: its axes, ticks, labels and grid are made once and each :meth:`draw`
+    replaces only the run's own artists (a figure made anew per run spent most of its time
+    creating ticks)."""
+
+    def __init__(self, palette: Palette) -> None:
+        self.palette = palette
+        # fixed margins: constrained layout would double the cost
+        self.figure = Figure(figsize=(8.0, 6.4))
+        # one time range set on all four (sharex would make each axis measure the tick
+        # labels of the others at every draw)
+        self.axes = self.figure.subplots(len(TRACE_QUANTITIES), 1)
+        for ax, key in zip(self.axes, TRACE_QUANTITIES):
+            ax.set_ylabel(QUANTITIES[key].axis_label)
+            ax.grid(alpha=0.3)
+            if ax is not self.axes[-1]:
+                ax.tick_params(labelbottom=False)
+        self.axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
+        self.title = self.figure.suptitle("", fontsize="medium")
+        self._drawn: list = []  # the artists of the run drawn last
+        self._legends: dict = {}  # (labels, trace colour) -> legend
+
+    def _clear(self) -> None:
+        for artist in self._drawn:
+            artist.remove()
+        self._drawn = []
+        for ax in self.axes:
+            ax.relim()  # no data left: limits from this run's artists only
+            ax.set_autoscale_on(True)
+
+    def _time_range(self) -> None:
+        """The time span of the run's artists on all four axes, with the default margins."""
+        spans = [ax.dataLim.intervalx for ax in self.axes
+                 if np.isfinite(ax.dataLim.intervalx).all()]
+        lo, hi = (min(s[0] for s in spans), max(s[1] for s in spans)) if spans else (0.0, 1.0)
+        pad = matplotlib.rcParams["axes.xmargin"] * (hi - lo) if hi > lo else 0.5
+        for ax in self.axes:
+            ax.set_xlim(lo - pad, hi + pad)
+
+    def _legend(self, colour: str) -> None:
+        labelled = {}
+        for ax in self.axes:
+            labelled.update(zip(*reversed(ax.get_legend_handles_labels())))
+        key = (tuple(labelled), colour)
+        if key not in self._legends:
+            self._legends[key] = self.figure.legend(
+                labelled.values(), labelled.keys(), loc="lower center", ncols=len(labelled),
+                frameon=False, fontsize="small")
+        self.figure.legends[:] = [self._legends[key]]
+
+    def draw(self, run: RunRecord) -> Figure:
+        """The figure showing ``run``: its stored traces (min/max per block,
+        ``run_results.traces``), the stable window shaded with each quantity's mean over it;
+        a run with no stable phase gets the reason in its title. A run processed before
+        traces were stored says so (and shows its stored DP trace, if it has no stable
+        phase)."""
+        self._clear()
+        top = 0.93 if run.status != "no_stable_phase" else 0.86
+        self.figure.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
+        colour = self.palette.colour(run.load_n)
+        drawn = self._drawn
+        for ax, key in zip(self.axes, TRACE_QUANTITIES):
+            q = QUANTITIES[key]
+            y_data = False
+            if run.window_start_s is not None and run.window_end_s is not None:
+                drawn.append(ax.axvspan(run.window_start_s, run.window_end_s,
+                                        color=WINDOW_COLOUR, zorder=0, label="stable window"))
+                if key in run.means:
+                    drawn.append(ax.hlines(run.means[key] * q.scale, run.window_start_s,
+                                           run.window_end_s, colors="k", linestyles="--",
+                                           lw=1.2, label="mean over window"))
+                    y_data = True
+            trace = None if run.traces is None else run.traces.get(key)
+            if trace is not None:
+                values = np.asarray(trace.values, float) * q.scale
+                drawn += ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
+                _robust_limits(ax, values)
+                continue
+            drawn.append(_no_data(ax, NOT_STORED if run.traces is None else "not measured"))
+            if key == "dp_n" and run.traces is None and run.dp_trace:  # older results: this
+                dp = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
+                drawn += ax.plot(run.dp_trace["t_s"], dp, color="k", lw=1.0,
+                                 label="stored DP trace")
+                y_data = True
+            if not y_data:
+                ax.set_ylim(0.0, 1.0)
+        self._time_range()
+        self._legend(colour)
+        title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass "
+                 f"{run.multipass}" + (f", slip set {100 * run.slip_setpoint:g} %"
+                                       if run.slip_setpoint is not None else ""))
+        if run.status == "no_stable_phase":
+            reason = plain_text("; ".join(run.flags))
+            title += "\n" + "\n".join(textwrap.wrap(reason, 110))
+        self.title.set_text(title)
+        self.title.set_color("#a00000" if run.status != "ok" else "k")
+        return self.figure
+
+
 def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
-    """Drawbar pull, torque, sinkage and slip against time from the traces stored at
-    processing (min/max per block, ``run_results.traces``), the stable window shaded with
-    each quantity's mean over it; a run with no stable phase gets the reason in its title.
-    A run processed before traces were stored says so (and shows its stored DP trace, if it
-    has no stable phase)."""
-    fig = Figure(figsize=(8.0, 6.4))  # fixed margins: constrained layout would double the cost
-    axes = fig.subplots(len(TRACE_QUANTITIES), 1, sharex=True)
-    top = 0.93 if run.status != "no_stable_phase" else 0.86
-    fig.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
-    colour = palette.colour(run.load_n)
-    for ax, key in zip(axes, TRACE_QUANTITIES):
-        q = QUANTITIES[key]
-        ax.set_ylabel(q.axis_label)
-        ax.grid(alpha=0.3)
-        if run.window_start_s is not None and run.window_end_s is not None:
-            ax.axvspan(run.window_start_s, run.window_end_s, color=WINDOW_COLOUR, zorder=0,
-                       label="stable window")
-            if key in run.means:
-                ax.hlines(run.means[key] * q.scale, run.window_start_s, run.window_end_s,
-                          colors="k", linestyles="--", lw=1.2, label="mean over window")
-        trace = None if run.traces is None else run.traces.get(key)
-        if trace is not None:
-            values = np.asarray(trace.values, float) * q.scale
-            ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
-            _robust_limits(ax, values)
-            continue
-        _no_data(ax, NOT_STORED if run.traces is None else "not measured")
-        if key == "dp_n" and run.traces is None and run.dp_trace:  # older results: this only
-            dp = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
-            ax.plot(run.dp_trace["t_s"], dp, color="k", lw=1.0, label="stored DP trace")
-    axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
-    labelled = {}
-    for ax in axes:
-        labelled.update(zip(*reversed(ax.get_legend_handles_labels())))
-    fig.legend(labelled.values(), labelled.keys(), loc="lower center", ncols=len(labelled),
-               frameon=False, fontsize="small")
-    title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass {run.multipass}"
-             + (f", slip set {100 * run.slip_setpoint:g} %" if run.slip_setpoint is not None
-                else ""))
-    if run.status == "no_stable_phase":
-        reason = plain_text("; ".join(run.flags))
-        title += "\n" + "\n".join(textwrap.wrap(reason, 110))
-    fig.suptitle(title, fontsize="medium",
-                 color="#a00000" if run.status != "ok" else "k")
-    return fig
+    """One run's time-series figure on a figure of its own (:class:`RunTimeseries`)."""
+    return RunTimeseries(palette).draw(run)
+
+
+def expanded_uncertainty(rows: pd.DataFrame, key: str) -> pd.Series | None:
+    """Each point's 95 % expanded uncertainty ``k sigma``: sigma the fits' (``<q>_se`` of the
+    fitting table: the larger of the run's combined standard uncertainty and its replicate
+    spread), k the coverage factor of the run's budget (``<q>_k``; 1.96 without one)."""
+    if f"{key}_se" not in rows:
+        return None
+    k = rows[f"{key}_k"].astype(float).fillna(NORMAL_K) if f"{key}_k" in rows else NORMAL_K
+    return rows[f"{key}_se"].astype(float) * k
 
 
 def _errorbars(ax, rows: pd.DataFrame, key: str, colour: str, marker: str,
                fitted: bool) -> None:
     q = QUANTITIES[key]
-    se = rows[f"{key}_se"] if f"{key}_se" in rows else None
+    u = expanded_uncertainty(rows, key)
     ax.errorbar(rows["slip"] * 100.0, rows[key] * q.scale,
-                yerr=None if se is None else se * q.scale, fmt=marker, ms=5, color=colour,
-                mfc=colour if fitted else "white", capsize=2.5, lw=1, zorder=3)
+                yerr=None if u is None else u * q.scale, fmt=marker, ms=MARKER_PT,
+                color=colour, mfc=colour if fitted else "white", capsize=2.5, lw=1, zorder=3)
+
+
+def hidden_errorbars(fig: Figure, keys) -> str | None:
+    """After ``fig`` is drawn: the error bars (:func:`_errorbars`) no longer than the marker
+    radius, per panel (``keys``: each panel's quantity) with the largest of them in the
+    display unit, as one sentence; None when every bar can be seen."""
+    radius_px = MARKER_PT * fig.dpi / 72.0 / 2.0 + 1.0  # + a pixel of anti-aliasing
+    parts = []
+    for ax, key in zip(fig.axes, keys):
+        hidden, total = [], 0
+        for container in ax.containers:
+            if not isinstance(container, ErrorbarContainer) or not container.has_yerr:
+                continue
+            for collection in container.lines[2]:  # (data line, caps, bar collections)
+                for segment in collection.get_segments():
+                    total += 1
+                    y0_px, y1_px = ax.transData.transform(segment)[:, 1]
+                    if abs(y1_px - y0_px) / 2.0 <= radius_px:
+                        hidden.append(abs(segment[1][1] - segment[0][1]) / 2.0)
+        if hidden:
+            q = QUANTITIES[key]
+            parts.append(f"U({q.label}) ≤ {max(hidden):.2g} {q.unit}"
+                         + ("" if len(hidden) == total else
+                            f" ({len(hidden)} of {total} points)"))
+    if not parts:
+        return None
+    return ("Error bars smaller than the markers: " + ", ".join(parts) + " (U: 95 % expanded "
+            "uncertainty of the mean, k·σ with σ the larger of the run's combined standard "
+            "uncertainty and its replicate spread).")
 
 
 def _curve(ax, curve, quantity: str, colour: str, ls: str = "-", lw: float = 1.6,
@@ -104,6 +205,47 @@ def _curve(ax, curve, quantity: str, colour: str, ls: str = "-", lw: float = 1.6
     slip = np.linspace(curve.slip_min, curve.slip_max, CURVE_POINTS)
     ax.plot(slip * 100.0, curve.evaluate(slip) * QUANTITIES[quantity].scale, color=colour,
             ls=ls, lw=lw, alpha=alpha)
+
+
+def _bands(ax, curve, quantity: str, colour: str) -> bool:
+    """A curve's 95 % confidence band (darker) and prediction band (lighter) shaded over its
+    slip range (``fitting.band``, docs/fitting.md "Bands"); False, nothing drawn, where the
+    curve carries no uncertainty."""
+    slip = np.linspace(curve.slip_min, curve.slip_max, CURVE_POINTS)
+    mean, conf, pred = band(curve, slip)
+    if not np.isfinite(pred).any():
+        return False
+    scale = QUANTITIES[quantity].scale
+    for half, alpha in ((pred, 0.08), (conf, 0.22)):
+        ax.fill_between(slip * 100.0, (mean - half) * scale, (mean + half) * scale,
+                        color=colour, alpha=alpha, lw=0, zorder=1)
+    return True
+
+
+def band_text(curves, keys) -> str:
+    """The largest 95 % half-widths of the curves' bands per quantity of ``keys``, in words
+    (the bands can be narrower than a curve's line); or that the curves carry none."""
+    parts = []
+    for key in keys:
+        widths = [np.nanmax(np.stack(band(c, np.linspace(c.slip_min, c.slip_max,
+                                                          CURVE_POINTS))[1:]), axis=1)
+                  for c in curves if c.quantity == key and c.covariance is not None]
+        if widths:
+            q = QUANTITIES[key]
+            conf, pred = np.nanmax(widths, axis=0) * q.scale
+            parts.append(f"{q.label} ± {conf:.2g} / ± {pred:.2g} {q.unit}")
+    if not parts:
+        return ("These curves carry no uncertainty (stored without their parameter "
+                "covariance): no bands drawn.")
+    return ("95 % bands (fitting.band: confidence, where the true curve lies / prediction, "
+            "where one new run's mean lies), their largest half-widths: " + ", ".join(parts)
+            + ".")
+
+
+def band_handles() -> list[Patch]:
+    """Legend entries of the two bands (:func:`_bands`)."""
+    return [Patch(color="0.3", alpha=0.22 + 0.08, label="95 % confidence band"),
+            Patch(color="0.3", alpha=0.08, label="95 % prediction band")]
 
 
 def _slip_axes(fig: Figure, keys) -> list:
@@ -119,11 +261,13 @@ def _slip_axes(fig: Figure, keys) -> list:
 def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, soil: str,
                        statuses, palette: Palette) -> Figure:
     """DP, torque, sinkage and resistance against slip for one wheel on one soil: every
-    load and multipass, means with their standard errors as error bars (hollow: runs whose
-    status is not in ``statuses``, i.e. not fitted) and the fitted polynomials."""
+    load and multipass, means with their 95 % expanded uncertainty as error bars
+    (:func:`expanded_uncertainty`; hollow: runs whose status is not in ``statuses``, i.e. not
+    fitted) and the fitted polynomials with their 95 % confidence and prediction bands."""
     fig = Figure(figsize=(11.0, 8.2), layout="constrained")
     axes = _slip_axes(fig, CURVE_QUANTITIES)
     mine = points[(points["wheel"] == wheel) & (points["soil"] == soil)]
+    banded = False
     for ax, key in zip(axes, CURVE_QUANTITIES):
         for (mp, load), rows in mine.groupby(["multipass", "load_n"]):
             rows = rows[np.isfinite(rows[key].astype(float))]
@@ -132,22 +276,25 @@ def performance_curves(points: pd.DataFrame, fits: list[CurveFit], wheel: str, s
         for f in fits:
             if (f.wheel, f.soil, f.quantity) == (wheel, soil, key):
                 _curve(ax, f, key, palette.colour(f.load_n), palette.line(f.multipass))
+                banded |= _bands(ax, f, key, palette.colour(f.load_n))
     handles = palette.legend_handles(mine["load_n"], mine["multipass"])
+    if banded:
+        handles += band_handles()
     if not mine["status"].isin(list(statuses)).all():
         handles.append(Line2D([], [], ls="", marker="o", color="0.3", mfc="white",
                               label="flagged, not fitted"))
     fig.legend(handles=handles, loc="outside right upper", title="load, soil pass")
-    fig.suptitle(f"{plain_text(wheel)} on {plain_text(soil)}: means ± standard error, "
-                 "fitted polynomials",
+    fig.suptitle(f"{plain_text(wheel)} on {plain_text(soil)}: means ± U95, fitted "
+                 "polynomials with their 95 % bands",
                  fontsize="medium")
     return fig
 
 
 def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, load_n: float,
                     checks: list[ValidationResult], palette: Palette) -> Figure:
-    """The curves at the tested loads interpolated to ``load_n`` (thick) against the runs at
-    ``load_n`` kept aside (points ± standard error), one panel per quantity, the RMSE as %
-    of the measured range in each title."""
+    """The curves at the tested loads interpolated to ``load_n`` (thick, with its bands)
+    against the runs at ``load_n`` kept aside (points ± 95 % expanded uncertainty), one panel
+    per quantity, the RMSE as % of the measured range in each title."""
     fig = Figure(figsize=(11.0, 8.2), layout="constrained")
     axes = _slip_axes(fig, CURVE_QUANTITIES)
     by_quantity = {c.quantity: c for c in checks}
@@ -155,6 +302,7 @@ def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, loa
     rows = points[(points["wheel"] == key[0]) & (points["soil"] == key[1])
                   & (points["multipass"] == key[2]) & np.isclose(points["load_n"], load_n)]
     colour, mp = palette.colour(load_n), key[2]
+    banded = False
     for ax, q in zip(axes, CURVE_QUANTITIES):
         tested = sets.get((*key, q), {})
         for load, curve in sorted(tested.items()):
@@ -164,6 +312,7 @@ def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, loa
                 warnings.simplefilter("ignore")
                 interpolated = interpolate_load(tested, load_n)
             _curve(ax, interpolated, q, colour, palette.line(mp), lw=3.0, alpha=0.85)
+            banded |= _bands(ax, interpolated, q, colour)
         ok = rows[np.isfinite(rows[q].astype(float))]
         _errorbars(ax, ok, q, colour, palette.marker(mp), fitted=True)
         check = by_quantity.get(q)
@@ -172,7 +321,8 @@ def load_validation(points: pd.DataFrame, fits: list[CurveFit], key: SetKey, loa
             ax.set_title(f"{unit.label.capitalize()}: RMSE {check.rmse * unit.scale:.3g} "
                          f"{unit.unit} = {check.rmse_pct_of_range:.2g} % of range",
                          fontsize="medium")
-    fig.legend(handles=palette.legend_handles([*sets.get((*key, "dp_n"), {}), load_n], [mp]),
+    handles = palette.legend_handles([*sets.get((*key, "dp_n"), {}), load_n], [mp])
+    fig.legend(handles=handles + (band_handles() if banded else []),
                loc="outside right upper", title="load")
     fig.suptitle(f"{plain_text(key[0])} on {plain_text(key[1])}, multipass {mp}: curves "
                  "interpolated to "

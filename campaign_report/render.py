@@ -9,6 +9,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from campaign_report import sections
+from campaign_report.replicates import replicates_section
 from campaign_report.data import CampaignData, campaign_names, gather
 from campaign_report.extensions import optional_sections
 from campaign_report.html import Page, render_page
@@ -46,7 +47,9 @@ def build_page(data: CampaignData, progress: Progress = _no_progress) -> Page:
     palette = Palette(data.loads, data.multipasses)
     images = [sections.timeseries_image(i, run, palette)
               for i, run in progress(list(enumerate(data.runs)), f"report {data.name}")]
-    parts = [sections.runs_section(data), sections.timeseries_section(images)]
+    parts = [s for s in (sections.runs_section(data), replicates_section(data, palette))
+             if s is not None]
+    parts.append(sections.timeseries_section(images))
     if data.fits:
         parts.append(sections.curves_section(data, palette))
     parts += [s for s in (sections.interpolation_section(data, palette),

@@ -1,15 +1,14 @@
-"""The campaign page's replicate section: the spread of runs of one test condition beside
-their within-run uncertainty (``swtlab.domain.replicates``), or the note that the campaign
-has no replicates."""
+"""The campaign page's replicate section, right after the run table: the spread of runs of
+one test condition beside their within-run uncertainty (``swtlab.domain.replicates``), or
+the note that the campaign has no replicates."""
 
 from __future__ import annotations
 
 import math
 
 from campaign_report.data import CampaignData
-from campaign_report.extensions import Extension, register
 from campaign_report.html import Note, Section, Table
-from campaign_report.style import Palette
+from campaign_report.style import QUANTITIES, Palette, Quantity
 from swtlab.domain.replicates import NO_REPLICATES, replicate_spread
 
 
@@ -27,9 +26,13 @@ def replicates_section(data: CampaignData, palette: Palette) -> Section | None:
     if spread.empty:
         return Section("replicates", "Repeatability", [Note(f"This campaign has {NO_REPLICATES}.",
                                                             warning=True)])
-    cells = [[r.mode, f"{r.load_set_n:g}", str(r.multipass), _slip(r.slip_setpoint), r.quantity,
-              str(r.runs), f"{r.mean:.4g}", f"{r.replicate_sd:.3g}", f"{r.within_u:.3g}",
-              f"{r.ratio:.2f}"] for r in spread.itertuples()]
+    cells = []
+    for r in spread.itertuples():
+        q = QUANTITIES.get(r.quantity, Quantity(r.quantity, "SI"))
+        cells.append([r.mode, f"{r.load_set_n:g}", str(r.multipass), _slip(r.slip_setpoint),
+                      q.axis_label, str(r.runs), f"{r.mean * q.scale:.4g}",
+                      f"{r.replicate_sd * q.scale:.3g}", f"{r.within_u * q.scale:.3g}",
+                      f"{r.ratio:.2f}"])
     larger = int((spread["larger"] == "replicates").sum())
     return Section("replicates", "Repeatability", [
         Note(f"Runs of one test condition (replicates): the spread of their means (sample "
@@ -40,5 +43,3 @@ def replicates_section(data: CampaignData, palette: Palette) -> Section | None:
                "replicate sd", "within-run u", "sd / u"], cells,
               numeric=frozenset({1, 2, 3, 5, 6, 7, 8, 9}))])
 
-
-register(Extension("replicates", replicates_section))

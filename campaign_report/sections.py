@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
+from functools import lru_cache
 from html import escape
 
 from campaign_report import figures
 from campaign_report.data import CampaignData, RunRecord
 from campaign_report.html import Heading, Image, Note, Section, Table
 from campaign_report.images import thumbnail, to_png
-from campaign_report.style import QUANTITIES, Palette
+from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from run_results.traces import MAX_TRACE_POINTS
 from wpm_export import WheelPerformanceModule
 
@@ -29,12 +30,17 @@ def _number(value: float | None, scale: float = 1.0, digits: int = 4) -> str:
     return "" if value is None else f"{value * scale:.{digits}g}"
 
 
-def _with_u95(run: RunRecord, key: str, scale: float = 1.0, digits: int = 4) -> str:
-    """``mean ± u95`` of a quantity (the mean alone where the run has no budget for it)."""
-    mean, u95 = run.means.get(key), run.u95.get(key)
-    if mean is None or u95 is None:
-        return _number(mean, scale, digits)
-    return f"{_number(mean, scale, digits)} ± {u95 * scale:.2g}"
+#: the run table's quantities: (key, short name, unit, display scale, digits of the mean)
+TABLE_QUANTITIES = (("slip", "slip", "%", 100.0, 3), ("dp_n", "DP", "N", 1.0, 4),
+                    ("torque_nm", "torque", "N·m", 1.0, 4),
+                    ("sinkage_m", "sinkage", "mm", 1000.0, 3))
+
+
+def _mean_and_u(run: RunRecord, key: str, scale: float, digits: int) -> list[str]:
+    """A quantity's mean and its combined standard uncertainty (empty: no budget)."""
+    u = run.u.get(key)
+    return [_number(run.means.get(key), scale, digits),
+            "" if u is None else f"{u * scale:.2g}"]
 
 
 def _window(run: RunRecord) -> str:
@@ -46,8 +52,9 @@ def _window(run: RunRecord) -> str:
 def runs_section(data: CampaignData) -> Section:
     """Every run: conditions, status, stable window, main means, flags and reasons."""
     header = ["run", "mode", "load [N]", "multipass", "slip set [%]", "velocity [mm/s]",
-              "status", "stable window [s]", "slip [%]", "DP [N]", "torque [N·m]",
-              "sinkage [mm]", "flags and reasons"]
+              "status", "stable window [s]",
+              *(h for _, name, unit, _, _ in TABLE_QUANTITIES
+                for h in (f"{name} [{unit}]", f"u({name}) [{unit}]")), "flags and reasons"]
     rows, classes = [], []
     for i, run in enumerate(data.runs):
         rows.append([
@@ -55,13 +62,14 @@ def runs_section(data: CampaignData) -> Section:
             f"{run.load_n:g}", str(run.multipass), _number(run.slip_setpoint, 100.0, 3),
             _number(run.velocity_mps, 1000.0, 3),
             f'<span class="status {escape(run.status)}">{escape(run.status)}</span>', _window(run),
-            _with_u95(run, "slip", 100.0, 3), _with_u95(run, "dp_n"),
-            _with_u95(run, "torque_nm"), _with_u95(run, "sinkage_m", 1000.0, 3),
+            *(cell for key, _, _, scale, digits in TABLE_QUANTITIES
+              for cell in _mean_and_u(run, key, scale, digits)),
             "; ".join(run.flags)])
         classes.append(run.status)
     for run_id, stage, reason in data.failed:
         rows.append([escape(run_id), "", "", "", "", "", '<span class="status failed">failed'
-                     '</span>', "none", "", "", "", "", f"{stage} failed: {reason}"])
+                     '</span>', "none", *[""] * (2 * len(TABLE_QUANTITIES)),
+                     f"{stage} failed: {reason}"])
         classes.append("failed")
     counts = {s: sum(r.status == s for r in data.runs) for s in ("ok", "flagged",
                                                                    "no_stable_phase")}
@@ -70,17 +78,26 @@ def runs_section(data: CampaignData) -> Section:
                f"{counts['no_stable_phase']} without a stable phase"
                + (f", {len(data.failed)} failed (could not be processed; the reason says why)"
                   if data.failed else "")
-               + ". Means over the stable window ± their 95 % expanded uncertainty (the run's "
-                 "uncertainty budget, docs/run-results.md); a run id opens its time series.")
+               + ". Means over the stable window and u( ), their combined standard uncertainty "
+                 "(the run's uncertainty budget: within-window statistics, zero drift, "
+                 "calibration, quantisation, phase sampling, clock; GUM, docs/run-results.md); "
+                 "their 95 % expanded uncertainty is k·u with k about 2 (swtlab results lists "
+                 "k, u95 and every term). A run id opens its time series.")
+    numeric = frozenset({2, 3, 4, 5, *range(8, 8 + 2 * len(TABLE_QUANTITIES))})
     return Section(RUNS, "Runs", [Note(summary), Table(
-        header, rows, numeric=frozenset({2, 3, 4, 5, 8, 9, 10, 11}), row_classes=classes,
-        html_columns=frozenset({0, 6}))])
+        header, rows, numeric=numeric, row_classes=classes, html_columns=frozenset({0, 6}))])
+
+
+@lru_cache(maxsize=1)
+def _timeseries_figure(palette: Palette) -> figures.RunTimeseries:
+    """The time-series figure of the page whose palette this is, reused for all its runs."""
+    return figures.RunTimeseries(palette)
 
 
 def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Image:
     """A run's time-series thumbnail/full-size pair; the caption says so when the run was
     processed before its traces were stored."""
-    png, image = to_png(figures.run_timeseries(run, palette))
+    png, image = to_png(_timeseries_figure(palette).draw(run))
     caption = (f"{run.run_id} · {run.status}"
                + (f" · {figures.NOT_STORED}" if run.traces is None else ""))
     return Image(run_anchor(index), caption, png, thumbnail(image), run.status)
@@ -118,6 +135,12 @@ def _source_notes(data: CampaignData) -> list[Note]:
     return notes
 
 
+def _errorbar_note(fig) -> list[Note]:
+    """The note under a drawn slip figure whose error bars hide behind their markers."""
+    text = figures.hidden_errorbars(fig, CURVE_QUANTITIES)
+    return [] if text is None else [Note(text)]
+
+
 def curves_section(data: CampaignData, palette: Palette) -> Section:
     """DP, torque, sinkage and resistance against slip per wheel and soil."""
     blocks: list = _source_notes(data)
@@ -126,7 +149,18 @@ def curves_section(data: CampaignData, palette: Palette) -> Section:
                                          data.source.statuses, palette)
         blocks.append(Image(f"curves-{len(blocks)}", f"{wheel} on {soil}: performance curves",
                             to_png(fig)[0]))
+        blocks += _errorbar_note(fig)
+        blocks.append(Note(figures.band_text(
+            [f for f in data.fits if (f.wheel, f.soil) == (wheel, soil)], CURVE_QUANTITIES)))
     return Section(CURVES, "Performance curves", blocks)
+
+
+def _inside_band(check) -> str:
+    """``k of n`` runs in the slip range inside the interpolated prediction band."""
+    n = check.n_points - check.n_outside_slip_range
+    if check.fraction_inside_band != check.fraction_inside_band:  # NaN: no band
+        return "unknown (no band)"
+    return f"{check.n_inside_band} of {n}"
 
 
 def interpolation_section(data: CampaignData, palette: Palette) -> Section | None:
@@ -135,18 +169,22 @@ def interpolation_section(data: CampaignData, palette: Palette) -> Section | Non
         return None
     blocks: list = [Note("Runs at a load with too few slips for a curve of its own, between "
                          "tested loads, check the load interpolation (RUAG WPAT's 120 N "
-                         "check): the curves at the other loads are interpolated to it.")]
+                         "check): the curves at the other loads are interpolated to it, with "
+                         "the 95 % bands propagated through the interpolation; the table "
+                         "counts the runs inside its prediction band.")]
     for key, (load, checks) in data.validation.items():
         blocks.append(Heading(f"{key[0]} on {key[1]}, multipass {key[2]}: {load:g} N"))
         fig = figures.load_validation(data.points, data.fits, key, load, checks, palette)
         blocks.append(Image(f"interp-{len(blocks)}", f"interpolated to {load:g} N",
                             to_png(fig)[0]))
+        blocks += _errorbar_note(fig)
         rows = [[(q := QUANTITIES[c.quantity]).label, f"{c.rmse * q.scale:.3g} {q.unit}",
-                 f"{c.rmse_pct_of_range:.2g}", str(c.n_points), str(c.n_outside_slip_range)]
-                for c in checks]
+                 f"{c.rmse_pct_of_range:.2g}", str(c.n_points), str(c.n_outside_slip_range),
+                 _inside_band(c)] for c in checks]
         blocks.append(Table(["quantity", "RMSE", "% of measured range", "runs",
-                             "beyond the tested slips (not in RMSE)"], rows,
-                            numeric=frozenset({1, 2, 3, 4})))
+                             "beyond the tested slips (not in RMSE)",
+                             "inside the 95 % prediction band"], rows,
+                            numeric=frozenset({1, 2, 3, 4, 5})))
     return Section(INTERPOLATION, "Load interpolation check", blocks)
 
 

@@ -42,6 +42,8 @@ QUANTITIES = {
     "sinkage_m": Quantity("sinkage", "mm", 1000.0),
     "resistance_n": Quantity("motion resistance", "N"),
     "dp_over_w": Quantity("drawbar pull / wheel load", "-"),
+    "wheel_load_n": Quantity("wheel load", "N"),
+    "travel_velocity_mps": Quantity("travel velocity", "mm/s", 1000.0),
     "slip": Quantity("slip", "%", 100.0),
     "t_s": Quantity("time", "s"),
 }

@@ -278,3 +278,44 @@ def test_cli_errors_are_one_line_with_what_to_do(small, tmp_path, capsys, case):
     assert {"missing file": "run swtlab process", "unknown campaign": "bb2_sand_sample",
             "empty database": "run swtlab process first"}[case] in err
     assert not (tmp_path / "r.html").exists() and not (tmp_path / "none.sqlite").exists()
+
+
+def test_run_table_shows_each_runs_stored_standard_uncertainty(small):
+    url, _, text = small
+    with open_database(url)() as session:
+        stored = latest_results(session).set_index("run_id")
+    header = re.search(r"<section id=\"runs\">.*?<thead><tr>(.*?)</tr>", text).group(1)
+    columns = [unescape(h) for h in re.findall(r"<th>(.*?)</th>", header)]
+    for name, unit in (("slip", "%"), ("DP", "N"), ("torque", "N·m"), ("sinkage", "mm")):
+        assert f"u({name}) [{unit}]" in columns
+    row = re.search(r'<tr class="ok"><td><a href="#full-run-\d+">L180_MP0_SC_s\+020</a>(.*?)</tr>',
+                    text).group(1)
+    cells = ["L180_MP0_SC_s+020", *re.findall(r"<td[^>]*>(.*?)</td>", row)]
+    for column, key, scale in (("u(DP) [N]", "dp_n", 1.0), ("u(sinkage) [mm]", "sinkage_m", 1e3),
+                               ("u(slip) [%]", "slip", 100.0)):
+        assert float(cells[columns.index(column)]) == pytest.approx(
+            stored.loc["L180_MP0_SC_s+020", f"{key}_u"] * scale, rel=0.05)  # 2 digits shown
+
+
+def test_hidden_error_bars_get_a_note_and_repeatability_follows_the_run_table(small):
+    _, _, text = small
+    page = unescape(text)
+    # the sample's U95(DP) is about 0.4 N on an axis of some 200 N: under a marker
+    note = re.search(r"Error bars smaller than the markers: U\(drawbar pull\) ≤ ([0-9.]+) N",
+                     page)
+    assert note and 0.2 < float(note.group(1)) < 1.0
+    titles = re.findall(r"<h2>(.*?)</h2>", text)
+    assert titles[:3] == ["Runs", "Repeatability", "Time series per run"]
+    assert "This campaign has no replicate runs" in page
+
+
+def test_bands_on_the_interpolation_check_and_a_note_for_curves_without_them(small):
+    _, _, text = small
+    page = unescape(text)
+    section = page[page.index('<section id="interpolation">'):]
+    section = section[:section.index("</section>")]
+    assert "<th>inside the 95 % prediction band</th>" in section
+    inside = re.findall(r"<td class=num>(\d+) of (\d+)</td>", section)
+    assert inside and all(int(k) <= int(n) for k, n in inside)
+    # the small campaign's curves come from its export, stored without their covariance
+    assert "These curves carry no uncertainty" in page
