@@ -34,6 +34,9 @@ from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
 from swtlab_cli.progress import progress
 
+#: how long ``--dask`` waits for its scheduler
+CONNECT_TIMEOUT_S = 20
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
@@ -89,7 +92,7 @@ def _client(address: str):
         raise ValueError("--dask needs dask.distributed (pip install 'dask[distributed]')"
                          ) from None
     try:
-        return Client(address, timeout="20s")
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
     except (OSError, TimeoutError, ValueError) as error:
         raise ValueError(f"--dask {address}: cannot reach the scheduler ({error})") from None
 

@@ -107,38 +107,33 @@ def process_file(path: Path, settings: ProcessSettings,
     """Read one raw file, find its stable phase, compute its results and its soil flow. Never
     raises for a bad run: what failed is in ``failures`` (ingest: nothing else is done).
     ``content``: the file's (sha256, size in bytes) when the caller has hashed it already.
-    Linear algebra runs on one thread (the arrays are small; several BLAS threads per run
-    only contend, most with other runs for the same cores)."""
-    from threadpoolctl import threadpool_limits
-
-    with threadpool_limits(limits=1, user_api="blas"):
-        return _process_file(Path(path), settings, content)
-
-
-def _process_file(path: Path, settings: ProcessSettings,
-                  content: tuple[str, int] | None) -> ProcessedRun:
+    Linear algebra runs on one thread (the arrays are small: several BLAS threads per run
+    only contend, with each other and with the other runs' workers)."""
     import ingest
     from ingest.inspect_report import report
     from run_results import process_run
     from softflow.track_run import run_image_slip
+    from threadpoolctl import threadpool_limits
     from traceability.hashing import content_sha256
 
+    path = Path(path)
     done = ProcessedRun(path=path, sha256="")
-    try:
-        done.sha256, done.size_bytes = content or content_sha256(path)
-        done.run = ingest.read_run(path, channel_map=settings.channel_map)
-        done.streams = report(done.run)["streams"]
-    except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
-        done.run = None
-        done.failures.append(Failure.of(path, "ingest", error))
-        return done
-    try:
-        done.result = process_run(done.run, settings.stable, settings.rig,
-                                  run_image_slip(done.run), settings.budget)
-    except Exception as error:  # noqa: BLE001
-        done.failures.append(Failure.of(path, "results", error))
-        return done
-    _soil_flow(done, settings)
+    with threadpool_limits(limits=1, user_api="blas"):  # the libraries imported above
+        try:
+            done.sha256, done.size_bytes = content or content_sha256(path)
+            done.run = ingest.read_run(path, channel_map=settings.channel_map)
+            done.streams = report(done.run)["streams"]
+        except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
+            done.run = None
+            done.failures.append(Failure.of(path, "ingest", error))
+            return done
+        try:
+            done.result = process_run(done.run, settings.stable, settings.rig,
+                                      run_image_slip(done.run), settings.budget)
+        except Exception as error:  # noqa: BLE001
+            done.failures.append(Failure.of(path, "results", error))
+            return done
+        _soil_flow(done, settings)
     return done
 
 
