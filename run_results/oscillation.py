@@ -19,18 +19,19 @@ GRID_SAMPLES_PER_CYCLE = 16  # block means per cycle of the highest harmonic in 
 
 
 def _design(t_s: np.ndarray, frequency_hz: np.ndarray, harmonics: int) -> np.ndarray:
-    """Design matrices ``[1, t - mean, cos k phi, sin k phi]`` (k = 1..harmonics), one per
-    frequency: shape (frequencies, samples, 2 harmonics + 2). The harmonics are powers of
+    """Regressors ``[1, t - mean, cos k phi, sin k phi]`` (k = 1..harmonics) as rows, one set
+    per frequency: shape (frequencies, 2 harmonics + 2, samples). The harmonics are powers of
     ``exp(i phi)`` (one complex exponential per sample and frequency, not one cos and one
     sin per harmonic)."""
-    n = t_s.size
     rotation = np.exp(2j * np.pi * np.asarray(frequency_hz, float)[:, None] * (t_s - t_s[0]))
-    powers = np.cumprod(np.repeat(rotation[:, :, None], harmonics, axis=2), axis=2)
-    a = np.empty((rotation.shape[0], n, 2 * harmonics + 2))
-    a[:, :, 0] = 1.0
-    a[:, :, 1] = t_s - t_s.mean()
-    a[:, :, 2:harmonics + 2] = powers.real
-    a[:, :, harmonics + 2:] = powers.imag
+    a = np.empty((rotation.shape[0], 2 * harmonics + 2, t_s.size))
+    a[:, 0] = 1.0
+    a[:, 1] = t_s - t_s.mean()
+    power = rotation
+    for k in range(harmonics):
+        if k:
+            power = power * rotation
+        a[:, 2 + k], a[:, 2 + harmonics + k] = power.real, power.imag
     return a
 
 
@@ -39,9 +40,8 @@ def _fits(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
     """Coefficients (frequencies, 2 harmonics + 2) and residual sums of squares of the
     least-squares series at each frequency (normal equations: 2k+2 unknowns)."""
     a = _design(t_s, frequency_hz, harmonics)
-    at = a.transpose(0, 2, 1)
-    coef = np.linalg.solve(at @ a, (at @ y)[:, :, None])
-    return coef[:, :, 0], np.sum((y - (a @ coef)[:, :, 0]) ** 2, axis=1)
+    coef = np.linalg.solve(a @ a.transpose(0, 2, 1), (a @ y)[:, :, None])
+    return coef[:, :, 0], np.sum((y - (coef.transpose(0, 2, 1) @ a)[:, 0]) ** 2, axis=1)
 
 
 def harmonic_fit(t_s, y, frequency_hz: float, harmonics: int = HARMONICS) -> dict:
