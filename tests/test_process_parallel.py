@@ -86,9 +86,13 @@ def test_a_dask_cluster_of_two_workers_gives_the_serial_results(campaign, serial
         assert _process(campaign, db, "--dask", cluster.scheduler_address) == 0
         assert _rows(db) == serial
         with distributed.Client(cluster) as client:
-            on_cluster = swtlab.process_campaign(campaign, client=client, soil_flow=False)
+            on_cluster = swtlab.process_campaign(campaign, client=client, soil_flow=False,
+                                                 keep_samples=False)
     here = swtlab.process_campaign(campaign, soil_flow=False)
     pd.testing.assert_frame_equal(on_cluster.results, here.results)
+    read = [r for r in on_cluster.runs if r.run is not None]
+    assert len(read) == 5 and all(r.run.channels.empty and not r.run.streams for r in read)
+    assert all(len(r.run.channels) > 1000 for r in here.runs if r.run is not None)
     assert on_cluster.failures == here.failures and len(here.failures) == 1
     assert here.failures[0].stage == "ingest" and "broken.mcap" in here.failures[0].file
 
