@@ -128,7 +128,8 @@ def main(quick: bool = False) -> dict:
     process_file(synthetic[0], ProcessSettings(max_frames=0))   # imports, caches: not timed
     rows = {
         "sample: swtlab process_file": (len(sample), _swtlab_runs(sample)),
-        "sample: swtlab process -> SQLite, --jobs 1": (len(sample), _swtlab_process_db(SAMPLE)),
+        "sample: swtlab process -> SQLite, --jobs 1":
+            (len(sample), _swtlab_process_db(SAMPLE, 1)[:2]),
         "sample: naive per-sample (MCAP runs)": (len(sample_mcap), _naive(sample_mcap)),
         "1 kHz synthetic: swtlab process_file": (len(synthetic), _swtlab_runs(synthetic)),
         "1 kHz synthetic: naive per-sample": (len(synthetic), _naive(synthetic)),
