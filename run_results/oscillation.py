@@ -18,19 +18,42 @@ MAX_GRID = 2000      # grid points over the band at most (a window of ~1000 peri
 GRID_SAMPLES_PER_CYCLE = 16  # block means per cycle of the highest harmonic in the grid stage
 
 
-def _design(t_s: np.ndarray, frequency_hz: float, harmonics: int) -> np.ndarray:
-    phase = 2.0 * np.pi * frequency_hz * (t_s - t_s[0])[:, None] * np.arange(1, harmonics + 1)
-    tc = (t_s - t_s.mean())[:, None]
-    return np.hstack([np.ones_like(tc), tc, np.cos(phase), np.sin(phase)])
+def _design(t_s: np.ndarray, frequency_hz: np.ndarray, harmonics: int) -> np.ndarray:
+    """Regressors ``[1, t - mean, cos k phi, sin k phi]`` (k = 1..harmonics) as rows, one set
+    per frequency: shape (frequencies, 2 harmonics + 2, samples). The harmonics are powers of
+    ``exp(i phi)`` (one complex exponential per sample and frequency, not one cos and one
+    sin per harmonic)."""
+    rotation = np.exp(2j * np.pi * np.asarray(frequency_hz, float)[:, None] * (t_s - t_s[0]))
+    a = np.empty((rotation.shape[0], 2 * harmonics + 2, t_s.size))
+    a[:, 0] = 1.0
+    a[:, 1] = t_s - t_s.mean()
+    power = rotation
+    for k in range(harmonics):
+        if k:
+            power = power * rotation
+        a[:, 2 + k], a[:, 2 + harmonics + k] = power.real, power.imag
+    return a
+
+
+def _fits(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
+          harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+    """Coefficients (frequencies, 2 harmonics + 2) and residual sums of squares of the
+    least-squares series at each frequency (normal equations: 2k+2 unknowns)."""
+    a = _design(t_s, frequency_hz, harmonics)
+    coef = np.linalg.solve(a @ a.transpose(0, 2, 1), (a @ y)[:, :, None])
+    return coef[:, :, 0], np.sum((y - (coef.transpose(0, 2, 1) @ a)[:, 0]) ** 2, axis=1)
 
 
 def harmonic_fit(t_s, y, frequency_hz: float, harmonics: int = HARMONICS) -> dict:
     """Least-squares mean + trend + harmonic series at ``frequency_hz`` (NaNs dropped)."""
     t_s, y = np.asarray(t_s, float), np.asarray(y, float)
     ok = np.isfinite(y)
-    a = _design(t_s[ok], frequency_hz, harmonics)
-    coef = np.linalg.solve(a.T @ a, a.T @ y[ok])   # normal equations: 2k+2 unknowns
-    return {"coef": coef, "rss": float(np.sum((y[ok] - a @ coef) ** 2)), "harmonics": harmonics}
+    coef, rss = _fits(t_s[ok], y[ok], np.array([frequency_hz]), harmonics)
+    return {"coef": coef[0], "rss": float(rss[0]), "harmonics": harmonics}
+
+
+#: design-matrix elements per batch of grid frequencies (bounds the grid stage's memory)
+BATCH_ELEMENTS = 2_000_000
 
 
 def measure_frequency_hz(t_s, y, expected_hz: float, harmonics: int = HARMONICS) -> float:
@@ -58,7 +81,9 @@ def measure_frequency_hz(t_s, y, expected_hz: float, harmonics: int = HARMONICS)
     n = t_s.size // block * block
     t_grid = t_s[:n].reshape(-1, block).mean(axis=1)
     y_grid = y[:n].reshape(-1, block).mean(axis=1)
-    rss = [harmonic_fit(t_grid, y_grid, f, harmonics)["rss"] for f in grid]
+    per_batch = max(1, BATCH_ELEMENTS // (t_grid.size * (2 * harmonics + 2)))
+    rss = np.concatenate([_fits(t_grid, y_grid, grid[i:i + per_batch], harmonics)[1]
+                          for i in range(0, grid.size, per_batch)])
     best = float(grid[int(np.argmin(rss))])
     width = grid[1] - grid[0]
     result = minimize_scalar(lambda f: harmonic_fit(t_s, y, f, harmonics)["rss"],

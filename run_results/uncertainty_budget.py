@@ -52,7 +52,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import optimize, special
 
 from run_results.native import MIN_SAMPLES_PER_BIN, channel_samples, hub_samples
 from run_results.phase_average import phase_average
@@ -181,19 +181,22 @@ def _rss(terms: list[Term]) -> Term:
 
 
 def _t97(dof: float) -> float:
-    return 1.959963984540054 if math.isinf(dof) else float(stats.t.ppf(0.975, max(dof, 1.0)))
+    return 1.959963984540054 if math.isinf(dof) else float(special.stdtrit(max(dof, 1.0), 0.975))
+
+
+SQRT_2PI = math.sqrt(2.0 * math.pi)
 
 
 def rect_normal_quantile(a: float, sigma: float, p: float = 0.975) -> float:
     """``x`` with ``P(X <= x) = p`` for ``X = N(0, sigma^2) + U(-a, a)`` (exact CDF:
     ``sigma/(2a) [G((x+a)/sigma) - G((x-a)/sigma)]``, ``G(z) = z Phi(z) + phi(z)``)."""
     if a <= 0:
-        return float(stats.norm.ppf(p)) * sigma
+        return float(special.ndtri(p)) * sigma
     if sigma <= 0:
         return a * (2 * p - 1)
 
     def cdf(x: float) -> float:
-        g = lambda z: z * stats.norm.cdf(z) + stats.norm.pdf(z)  # noqa: E731
+        g = lambda z: z * special.ndtr(z) + math.exp(-z * z / 2.0) / SQRT_2PI  # noqa: E731
         return sigma / (2 * a) * (g((x + a) / sigma) - g((x - a) / sigma)) - p
     hi = a + 10 * sigma
     if not cdf(hi) > 0:  # sigma so small against a that the difference cancels: rectangular

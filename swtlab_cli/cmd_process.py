@@ -7,6 +7,9 @@ traces (``run_results.traces``), which the report draws. A run with side-camera 
 also gets its soil flow over the stable window (``softflow.flow_run``); frames that cannot
 be analysed are reported and recorded, and the run's other results are kept.
 
+Runs are computed in ``--jobs`` worker processes (default: the cores this process may run
+on), or on a dask.distributed cluster with ``--dask ADDRESS`` (docs/scale-out.md); this
+process is the one writer, storing each run in the order of the files as it comes back.
 Runs are processed outside any transaction and stored under the database's write lock
 (``traceability.database``), so several ``swtlab process`` may write one database at once.
 Versions (docs/results.md): a changed file is its run's new current version, another file
@@ -30,6 +33,9 @@ from pathlib import Path
 from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
 from swtlab_cli.progress import progress
+
+#: how long ``--dask`` waits for its scheduler
+CONNECT_TIMEOUT_S = 20
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -55,15 +61,47 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="store a file that claims the run_id of a run stored from another "
                              "file as that run's new version (default: refused, naming both "
                              "files)")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--jobs", type=_jobs, default=None,
+                       help="worker processes computing runs (default: the cores available "
+                            "to this process); 1: all in this process")
+    where.add_argument("--dask", metavar="SCHEDULER_ADDRESS",
+                       help="compute the runs on this dask.distributed scheduler's workers "
+                            "(e.g. tcp://10.0.0.5:8786; they must see CAMPAIGN at the same "
+                            "path); this process stores them (docs/scale-out.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.set_defaults(func=run)
+
+
+def _jobs(text: str) -> int:
+    try:
+        jobs = int(text)
+    except ValueError:
+        jobs = 0
+    if jobs < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1")
+    return jobs
+
+
+def _client(address: str):
+    """A dask.distributed client of the scheduler at ``address``; a one-line error when
+    dask is not installed or the scheduler cannot be reached."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ValueError("--dask needs dask.distributed (pip install 'dask[distributed]')"
+                         ) from None
+    try:
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+    except (OSError, TimeoutError, ValueError) as error:
+        raise ValueError(f"--dask {address}: cannot reach the scheduler ({error})") from None
 
 
 def run(args: argparse.Namespace) -> int:
     import ingest
     from swtlab.pipeline.database import store_one
-    from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
-                                         process_file, rig_compliance)
+    from swtlab.pipeline.process import (ProcessSettings, available_cores, budget_params,
+                                         find_runs, process_files, rig_compliance)
     from traceability import open_database
     from traceability.database import in_transaction
     from traceability.hashing import content_sha256
@@ -77,6 +115,7 @@ def run(args: argparse.Namespace) -> int:
         settings = ProcessSettings(channel_map=args.channel_map,
                                    rig=rig_compliance(args.campaign, args.rig_compliance),
                                    budget=budget_params(args.campaign))
+        client = _client(args.dask) if args.dask else None
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
         print(f"swtlab process: {error}", file=sys.stderr)
         return exit_codes.BAD_INPUT
@@ -88,13 +127,14 @@ def run(args: argparse.Namespace) -> int:
     flow_failed: list[str] = []
     flows = up_to_date = 0
     new: list[tuple] = []   # (path, sha256, result) stored now: their drift is pooled below
-    for path in progress(paths, desc="process", quiet=args.quiet):
+    todo: list[tuple] = []  # (path, (sha256, size) or None): not yet processed
+    for path in paths:
         try:
-            sha256, _ = content_sha256(path)
+            content = content_sha256(path)
         except OSError:
-            sha256 = None  # unreadable: process_file records why
+            content = None  # unreadable: process_file records why
 
-        def known(session, path=path, sha256=sha256):
+        def known(session, path=path, sha256=content and content[0]):
             if sha256 is None or not processed_file(session, path, sha256, params_hash):
                 return None
             failure = stored_flow_failure(session, path, sha256, params_hash)
@@ -104,25 +144,34 @@ def run(args: argparse.Namespace) -> int:
         if known_flow_failures is not None:
             up_to_date += 1
             flow_failed += known_flow_failures
-            continue
-        processed = process_file(path, settings)  # outside any transaction: no lock held
-        stored = store_one(session_factory, processed, parameters,
-                           allow_run_id_reuse=args.allow_run_id_reuse)
-        failed += [f.reason if f.error_type == "IngestError" else f"{f.file}: {f.stage}: {f.reason}"
-                   for f in processed.failures if f.stage != "soil_flow"]
-        if processed.result is None or any(f.stage == "store" for f in processed.failures):
-            continue
-        if not stored:
-            up_to_date += 1
-            continue
-        result = processed.result
-        new.append((path, sha256, result))
-        flows += processed.flow is not None
-        flow_failed += [f"{processed.run.source}: /camera/side: {f.reason}"
-                        for f in processed.failures if f.stage == "soil_flow"]
-        reasons = "; ".join(result.flags)
-        statuses.setdefault(result.status, []).append(
-            f"{result.run_id}: {reasons}" if reasons else result.run_id)
+        else:
+            todo.append((path, content))
+    # computed by the workers (outside any transaction: no lock held), stored here in order
+    computed = process_files([p for p, _ in todo], settings, args.jobs or available_cores(),
+                             client=client, contents=[c for _, c in todo], keep_samples=False)
+    try:
+        for processed in progress(computed, desc="process", total=len(todo), quiet=args.quiet):
+            stored = store_one(session_factory, processed, parameters,
+                               allow_run_id_reuse=args.allow_run_id_reuse)
+            failed += [f.reason if f.error_type == "IngestError"
+                       else f"{f.file}: {f.stage}: {f.reason}"
+                       for f in processed.failures if f.stage != "soil_flow"]
+            if processed.result is None or any(f.stage == "store" for f in processed.failures):
+                continue
+            if not stored:
+                up_to_date += 1
+                continue
+            result = processed.result
+            new.append((processed.path, processed.sha256, result))
+            flows += processed.flow is not None
+            flow_failed += [f"{processed.run.source}: /camera/side: {f.reason}"
+                            for f in processed.failures if f.stage == "soil_flow"]
+            reasons = "; ".join(result.flags)
+            statuses.setdefault(result.status, []).append(
+                f"{result.run_id}: {reasons}" if reasons else result.run_id)
+    finally:
+        if client is not None:
+            client.close()
     missing = in_transaction(session_factory, lambda session: [
         f"{row.path} (run {row.run.run_id})" for row in mark_missing(session, args.campaign)])
     if new:

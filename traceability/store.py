@@ -105,8 +105,8 @@ def _claimed(db_run: Run, path: str, campaign: str) -> RunIdClaimed:
 
 
 def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, Any],
-                       parameters: dict[str, Any], *, allow_run_id_reuse: bool = False
-                       ) -> tuple[RawFile, StoreOutcome]:
+                       parameters: dict[str, Any], *, allow_run_id_reuse: bool = False,
+                       content: tuple[str, int] | None = None) -> tuple[RawFile, StoreOutcome]:
     """Record ``run`` (an ``ingest.Run``) and its raw file; return the raw-file row and the
     outcome.
 
@@ -118,7 +118,8 @@ def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, An
     stored run_id raises :class:`RunIdClaimed` unless ``allow_run_id_reuse``; a name the
     database cannot hold raises ``TextRefused``. ``parameters`` (channel map, derivation
     methods) go into the processing record of a new version; an unchanged file writes
-    nothing."""
+    nothing. ``content``: the file's (sha256, size in bytes) when the caller hashed it
+    already (``traceability.hashing.content_sha256``), else it is hashed here."""
     meta = run.metadata
     path = str(Path(run.source).resolve())
     calibrations = _calibrations(meta)
@@ -130,7 +131,7 @@ def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, An
             checked_name(what, name)
     except TextRefused as error:
         raise TextRefused(f"{path}: {error}") from None
-    sha256, size_bytes = content_sha256(Path(run.source))
+    sha256, size_bytes = content or content_sha256(Path(run.source))
     campaign = _get_or_create(session, Campaign, name=meta.run.campaign)
     known = session.scalars(select(RawFile).join(Run, Run.id == RawFile.run_pk).where(
         Run.campaign_id == campaign.id, RawFile.sha256 == sha256).order_by(RawFile.id)).first()

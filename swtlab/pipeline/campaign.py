@@ -45,7 +45,8 @@ def one_line(text: str) -> str:
 
 @dataclass
 class ProcessedRun:
-    """One raw file through the pipeline. ``run``: the ``ingest.Run`` (None when it could not
+    """One raw file through the pipeline: ``path``, its content's ``sha256`` and
+    ``size_bytes``; ``run``: the ``ingest.Run`` (None when it could not
     be read, or when the campaign was loaded from a database); ``result``: its
     ``run_results.RunResult``; ``flow``: its soil flow (``softflow.flow_run.RunFlow``) with
     ``flow_npz``, the packed arrays the database keeps; ``failures`` of any stage."""
@@ -58,6 +59,7 @@ class ProcessedRun:
     flow: Any = None
     flow_npz: bytes | None = None
     failures: list[Failure] = field(default_factory=list)
+    size_bytes: int | None = None
 
     @property
     def run_id(self) -> str | None:

@@ -9,6 +9,11 @@ from pathlib import Path
 from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun, one_line
 
 
+def _content(done: ProcessedRun) -> tuple[str, int] | None:
+    """The (sha256, size) of the raw file that ``done`` hashed, or None (hash it again)."""
+    return (done.sha256, done.size_bytes) if done.sha256 and done.size_bytes is not None else None
+
+
 def store_processed(session, done: ProcessedRun, parameters: dict, *,
                     allow_run_id_reuse: bool = False) -> bool:
     """Store one processed run in ``session`` (one transaction per run, the caller's): the
@@ -37,7 +42,8 @@ def store_processed(session, done: ProcessedRun, parameters: dict, *,
         with session.begin_nested():
             raw_file, _ = store_ingested_run(session, done.run, done.streams,
                                              {**parameters, "derivation": done.run.derivation},
-                                             allow_run_id_reuse=allow_run_id_reuse)
+                                             allow_run_id_reuse=allow_run_id_reuse,
+                                             content=_content(done))
     except (RunIdClaimed, TextRefused) as error:
         failure = Failure(str(done.path), "store", one_line(str(error)), type(error).__name__)
         if failure not in done.failures:

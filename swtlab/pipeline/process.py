@@ -1,9 +1,14 @@
-"""Raw files -> per-run results: ``process_file`` (one run, the function every worker runs)
-and ``process_campaign`` (a folder, serially or on a process pool). No database."""
+"""Raw files -> per-run results: ``process_file`` (one run, the function every worker runs),
+``process_files`` (many, in order: serially, on a process pool or on a dask.distributed
+cluster) and ``process_campaign`` (a folder). No database: whoever stores the runs is the
+one writer (docs/scale-out.md)."""
 
 from __future__ import annotations
 
+import dataclasses
+import os
 import tomllib
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -97,37 +102,78 @@ def _soil_flow(done: ProcessedRun, settings: ProcessSettings) -> None:
         done.flow, done.flow_npz = flow, pack_flow(flow.result, flow.first_frame)
 
 
-def process_file(path: Path, settings: ProcessSettings) -> ProcessedRun:
+def process_file(path: Path, settings: ProcessSettings,
+                 content: tuple[str, int] | None = None) -> ProcessedRun:
     """Read one raw file, find its stable phase, compute its results and its soil flow. Never
-    raises for a bad run: what failed is in ``failures`` (ingest: nothing else is done)."""
+    raises for a bad run: what failed is in ``failures`` (ingest: nothing else is done).
+    ``content``: the file's (sha256, size in bytes) when the caller has hashed it already.
+    Linear algebra runs on one thread (the arrays are small: several BLAS threads per run
+    only contend, with each other and with the other runs' workers)."""
     import ingest
     from ingest.inspect_report import report
     from run_results import process_run
     from softflow.track_run import run_image_slip
+    from threadpoolctl import threadpool_limits
     from traceability.hashing import content_sha256
 
     path = Path(path)
     done = ProcessedRun(path=path, sha256="")
-    try:
-        done.sha256 = content_sha256(path)[0]
-        done.run = ingest.read_run(path, channel_map=settings.channel_map)
-        done.streams = report(done.run)["streams"]
-    except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
-        done.run = None
-        done.failures.append(Failure.of(path, "ingest", error))
-        return done
-    try:
-        done.result = process_run(done.run, settings.stable, settings.rig,
-                                  run_image_slip(done.run), settings.budget)
-    except Exception as error:  # noqa: BLE001
-        done.failures.append(Failure.of(path, "results", error))
-        return done
-    _soil_flow(done, settings)
+    with threadpool_limits(limits=1, user_api="blas"):  # the libraries imported above
+        try:
+            done.sha256, done.size_bytes = content or content_sha256(path)
+            done.run = ingest.read_run(path, channel_map=settings.channel_map)
+            done.streams = report(done.run)["streams"]
+        except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
+            done.run = None
+            done.failures.append(Failure.of(path, "ingest", error))
+            return done
+        try:
+            done.result = process_run(done.run, settings.stable, settings.rig,
+                                      run_image_slip(done.run), settings.budget)
+        except Exception as error:  # noqa: BLE001
+            done.failures.append(Failure.of(path, "results", error))
+            return done
+        _soil_flow(done, settings)
     return done
 
 
-def _process(args: tuple[Path, ProcessSettings]) -> ProcessedRun:
-    return process_file(*args)
+def _process(path: Path, settings: ProcessSettings, content: tuple[str, int] | None,
+             keep_samples: bool) -> ProcessedRun:
+    done = process_file(path, settings, content)
+    if not keep_samples and done.run is not None:   # what the writer needs, not the samples
+        done.run = dataclasses.replace(done.run, streams={}, channels=done.run.channels.iloc[:0],
+                                       frames={})
+    return done
+
+
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity), the default number of jobs."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+
+
+def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *,
+                  client=None, contents: list | None = None,
+                  keep_samples: bool = True) -> Iterator[ProcessedRun]:
+    """:func:`process_file` of each of ``paths``, yielded in their order as they are done:
+    in this process (``jobs`` 1), on ``jobs`` worker processes, or on the workers of the
+    ``dask.distributed`` ``client``. ``contents``: each file's (sha256, size) or None;
+    ``keep_samples=False`` drops each run's sample tables (``streams``, ``channels``,
+    ``frames``) before it comes back from a worker (results, metadata and problems stay)."""
+    if jobs < 1:
+        raise ValueError(f"jobs {jobs} must be >= 1")
+    work = list(zip(paths, [settings] * len(paths), contents or [None] * len(paths),
+                    [keep_samples] * len(paths)))
+    if client is not None:
+        futures = client.map(_process, *zip(*work), pure=False)
+        for future in futures:
+            yield future.result()
+            future.release()
+    elif jobs > 1 and len(work) > 1:
+        with ProcessPoolExecutor(min(jobs, len(work))) as pool:
+            yield from pool.map(_process, *zip(*work))
+    else:
+        for w in work:
+            yield _process(*w)
 
 
 def campaign_of(runs: list[ProcessedRun], parameters: dict) -> Campaign:
@@ -169,14 +215,18 @@ def _name(path: Path) -> str:
 def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: int = 1, *,
                      rig_compliance_file: str | Path | None = None,
                      runs: list[str] | None = None, soil_flow: bool = True,
-                     progress=None) -> Campaign:
+                     progress=None, client=None, keep_samples: bool = True) -> Campaign:
     """Every run under ``folder`` -> :class:`Campaign`, without a database.
 
     ``channel_map``: TOML map (path or shipped name) for a lab's own files; ``jobs`` > 1 runs
-    :func:`process_file` on that many worker processes; ``rig_compliance_file``: overrides
+    :func:`process_file` on that many worker processes; ``client``: a
+    ``dask.distributed.Client`` whose workers run it instead (they must see ``folder`` at the
+    same path; docs/scale-out.md); ``rig_compliance_file``: overrides
     ``folder/swtlab.toml``; ``runs``: only the files whose name (without suffix) is listed;
-    ``soil_flow=False`` skips the side-camera analysis; ``progress``: wraps the file list
-    (e.g. ``tqdm``). A run that fails is in ``.failures`` and the batch goes on.
+    ``soil_flow=False`` skips the side-camera analysis; ``progress``: wraps the processed
+    runs as they come (e.g. ``tqdm``); ``keep_samples=False``: the runs come back without
+    their sample tables (see :func:`process_files`). A run that fails is in ``.failures`` and
+    the batch goes on.
     """
     if jobs < 1:
         raise ValueError(f"jobs {jobs} must be >= 1")
@@ -190,10 +240,5 @@ def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: i
                                rig=rig_compliance(Path(folder), rig_compliance_file),
                                max_frames=None if soil_flow else 0,
                                budget=budget_params(Path(folder)))
-    work = [(p, settings) for p in paths]
-    if jobs > 1:
-        with ProcessPoolExecutor(min(jobs, len(work))) as pool:
-            done = list(pool.map(_process, work))
-    else:
-        done = [_process(w) for w in (progress(work) if progress else work)]
-    return campaign_of(done, settings.parameters())
+    done = process_files(paths, settings, jobs, client=client, keep_samples=keep_samples)
+    return campaign_of(list(progress(done) if progress else done), settings.parameters())
