@@ -13,7 +13,7 @@ from ingest.raw import RawRun
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
-MAT5_TEXT = b"MATLAB 5.0 MAT-file"
+MAT_TEXT = b"MATLAB "  # "MATLAB 5.0 MAT-file, ..." (v5 to v7) or "MATLAB 7.3 MAT-file, ..."
 MAT73_HDF5_OFFSET = 512  # MATLAB v7.3: a 512-byte MATLAB header (user block), then HDF5
 TDMS_MAGIC = b"TDSm"
 ROSBAG1_MAGIC = b"#ROSBAG V2.0"
@@ -41,7 +41,7 @@ def sniff(path: Path) -> str:
         return "mcap_cdr" if _mcap_is_cdr(path) else "mcap"
     if head.startswith(HDF5_MAGIC):
         return "hdf5"
-    if head.startswith(MAT5_TEXT[:10]):  # "MATLAB 7.3 MAT-file" heads a v7.3 file too
+    if head.startswith(MAT_TEXT) and b"MAT-file" in head[:116]:
         if head[MAT73_HDF5_OFFSET:].startswith(HDF5_MAGIC):
             return "mat73"
         return "mat5"
@@ -50,7 +50,8 @@ def sniff(path: Path) -> str:
     if head.startswith(ROSBAG1_MAGIC):
         return "rosbag1"
     raise IngestError(path, None, f"not a run: unknown format (first bytes {head[:8]!r}); "
-                      "swtlab reads MCAP, HDF5, MATLAB .mat, NI TDMS, ROS 1/2 bags, CSV run folders "
+                      "swtlab reads MCAP, HDF5, MATLAB .mat, NI TDMS, ROS 1/2 bags, CSV run "
+                      "folders "
                       "(for a text log pass its channel map, e.g. --channel-map "
                       "cmu_3d_terramechanics)")
 

@@ -1,6 +1,6 @@
 """ROS reader (rosbags): ROS 1 bags, ROS 2 bags (sqlite3 or MCAP storage), CDR-encoded MCAP.
 
-The map's topic is the ROS topic; its field is a path into the message: ``force.x``
+The map's topic is the ROS topic; its field is a path into the message: ``wrench.force.x``
 (WrenchStamped), ``position[0]`` or ``position[wheel_joint]`` (JointState, by index or by
 joint name), ``data`` (Float64), ``data[1]`` (Float64MultiArray), ``point.x`` (PointStamped).
 Time: the message's ``header.stamp`` when it has one, else the bag's log time; counted
@@ -75,7 +75,7 @@ def _stamp_ns(message, log_ns: int) -> int:
 
 
 def _field(path: Path, topic: str, spec: str, message, index: int) -> float:
-    """The number at ``spec`` (``force.x``, ``position[0]``, ``position[wheel]``) in ``message``."""
+    """The number at ``spec`` (``wrench.force.x``, ``position[0]``, ``position[wheel]``) in ``message``."""
     value = message
     for step in spec.split("."):
         match = _STEP.fullmatch(step)
