@@ -21,9 +21,14 @@ ROS2_METADATA = "metadata.yaml"
 #: what ``sniff`` returns, one reader each
 FORMATS = ("mcap", "mcap_cdr", "hdf5", "mat5", "mat73", "tdms", "rosbag1", "rosbag2", "csv_run")
 
+#: the reader to try on a file whose first bytes are none of the above (a damaged file)
+BY_SUFFIX = {".mcap": "mcap", ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5", ".mat": "mat5",
+             ".tdms": "tdms", ".bag": "rosbag1"}
+
 
 def sniff(path: Path) -> str:
-    """The format of a run file or folder, from its first bytes (or a folder's marker file)."""
+    """The format of a run file or folder, from its first bytes (or a folder's marker file);
+    the extension only decides for a file whose first bytes are no known format's."""
     path = Path(path)
     if path.is_dir():
         if (path / ROS2_METADATA).is_file():
@@ -49,6 +54,8 @@ def sniff(path: Path) -> str:
         return "tdms"
     if head.startswith(ROSBAG1_MAGIC):
         return "rosbag1"
+    if path.suffix.lower() in BY_SUFFIX:  # unknown bytes: that format's reader says what is wrong
+        return BY_SUFFIX[path.suffix.lower()]
     raise IngestError(path, None, f"not a run: unknown format (first bytes {head[:8]!r}); "
                       "swtlab reads MCAP, HDF5, MATLAB .mat, NI TDMS, ROS 1/2 bags, CSV run "
                       "folders "
