@@ -70,3 +70,81 @@ def test_format_round_trips_to_the_mcap_table(fmt, tmp_path, spec_run, reference
         path = bare
     assert sniff(path) == fmt
     _assert_same_table(ingest.read_run(path, cmap), reference)
+
+
+def test_tdms_waveform_timing_gives_the_same_time_base(tmp_path, spec_run):
+    """A fixed-rate topic stored as waveform channels (wf_start_offset + i * wf_increment)
+    reads on the same time stamps as its t_ns channel (within float rounding of the step)."""
+    topic = "/tether/force"
+    dp = spec_run.topics[topic]["dp"]
+    t_ns = 7_000_000 + 25_000_000 * np.arange(len(dp), dtype=np.int64)  # 40 Hz from 7 ms
+    run = fw.SpecRun({topic: {"t_ns": t_ns, "dp": dp}}, {})
+    cmap = ingest.load_channel_map("spec")
+    from ingest.tdms_reader import read_tdms
+
+    raw = read_tdms(fw.write_tdms(run, tmp_path / "w.tdms", waveform=True), cmap)
+    np.testing.assert_allclose(raw.topics[topic].t_s, t_ns * 1e-9, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(raw.topics[topic].fields["dp"], dp)
+
+
+@pytest.mark.parametrize("fmt", ["hdf5", "mat5", "tdms", "rosbag1"])
+def test_format_is_recognised_by_content_not_extension(fmt, tmp_path, spec_run):
+    path = CASES[fmt][0](spec_run, tmp_path)
+    renamed = path.rename(tmp_path / "run_file.dat")
+    assert sniff(renamed) == fmt
+
+
+def _error(path, cmap=None) -> ingest.IngestError:
+    with pytest.raises(ingest.IngestError) as caught:
+        ingest.read_run(path, cmap)
+    message = str(caught.value)
+    assert "\n" not in message and str(path) in message
+    return caught.value
+
+
+@pytest.mark.parametrize("fmt", ["hdf5", "mat5", "mat73", "tdms", "rosbag1"])
+def test_truncated_file_is_one_line_error(fmt, tmp_path, spec_run):
+    write, cmap = CASES[fmt]
+    path = write(spec_run, tmp_path)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 3])
+    err = _error(path, cmap)
+    assert err.path == path
+
+
+def test_hdf5_channel_problems_name_the_channel(tmp_path, spec_run):
+    import h5py
+
+    path = fw.write_hdf5(spec_run, tmp_path / "run.h5")
+    with h5py.File(path, "a") as f:
+        del f["/tether/force/dp"]
+        f["/tether/force/dp"] = np.zeros(3)
+    err = _error(path)
+    assert err.channel == "/tether/force.dp" and "3 samples" in err.problem
+    with h5py.File(path, "a") as f:
+        del f["/tether/force/dp"]
+        f["/tether/force/dp"] = np.array([b"x"] * len(f["/tether/force/t_ns"]))
+    assert _error(path).channel == "/tether/force.dp"
+    with h5py.File(path, "a") as f:
+        del f["/tether/force/dp"]
+    err = _error(path)
+    assert err.channel == "/tether/force.dp" and "required channel missing" in err.problem
+
+
+def test_ros_field_path_errors_name_topic_and_field(tmp_path, spec_run):
+    path = fw.write_ros1(spec_run, tmp_path / "run.bag")
+    err = _error(path)  # the spec map's fields are not message paths
+    assert err.channel == "/hub/wrench.fx" and "has no field 'fx'" in err.problem
+    cmap = tmp_path / "joint.toml"
+    text = (Path(ingest.load_channel_map("spec_ros").path).read_text()
+            .replace("position[wheel]", "position[left]"))
+    cmap.write_text(text)
+    err = _error(path, cmap)
+    assert err.channel == "/wheel/encoder.position[left]" and "no joint 'left'" in err.problem
+
+
+def test_unknown_bytes_and_folders(tmp_path):
+    (tmp_path / "x.dat").write_bytes(b"\x00\x01garbage")
+    assert "not a run: unknown format" in _error(tmp_path / "x.dat").problem
+    (tmp_path / "empty").mkdir()
+    assert "not a run" in _error(tmp_path / "empty").problem
