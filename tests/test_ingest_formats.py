@@ -1,6 +1,6 @@
 """Every format ingests a virtual-testbed run to the same canonical table as its MCAP form.
 
-Each file is written by that format's own library (tests/format_writers.py) from the samples
+Each file is written by that format's own library (bench/format_files.py) from the samples
 of a committed sample-campaign MCAP; the reference is ``read_run`` of that MCAP.
 """
 
@@ -14,7 +14,7 @@ import pytest
 
 import ingest
 from ingest.formats import sniff
-from tests import format_writers as fw
+from bench import format_files as fw
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data" / "campaign" / "L070_MP0_SC_s+010.mcap"
 
@@ -47,16 +47,8 @@ def _assert_same_table(run, reference):
     assert run.derivation["time_base"] == reference.derivation["time_base"]
 
 
-CASES = {
-    "hdf5": (lambda r, d: fw.write_hdf5(r, d / "run.h5"), None),
-    "mat5": (lambda r, d: fw.write_mat5(r, d / "run.mat"), None),
-    "mat73": (lambda r, d: fw.write_mat73(r, d / "run.mat"), None),
-    "tdms": (lambda r, d: fw.write_tdms(r, d / "run.tdms"), None),
-    "rosbag1": (lambda r, d: fw.write_ros1(r, d / "run.bag"), "spec_ros"),
-    "rosbag2": (lambda r, d: fw.write_ros2(r, d / "bag2"), "spec_ros"),
-    "mcap_cdr": (lambda r, d: fw.write_ros2(r, d / "bag3", storage="mcap") / "bag3.mcap",
-                 "spec_ros"),
-}
+CASES = {**fw.WRITERS, "mcap_cdr": (
+    lambda r, d: fw.write_ros2(r, d / "bag3", storage="mcap") / "bag3.mcap", "spec_ros")}
 
 
 @pytest.mark.parametrize("fmt", list(CASES))

@@ -10,7 +10,7 @@ import pandas as pd
 
 import swtlab
 from swtlab_cli.main import main
-from tests import format_writers as fw
+from bench import format_files as fw
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
 RUNS = ("L070_MP0_SC_s+010", "L180_MP0_SC_s+020", "L300_MP1_SC_s+060")

@@ -1,5 +1,6 @@
 """Writers of one virtual-testbed run in each format, each with that format's own library
-(h5py, scipy.io.savemat, npTDMS, rosbags): the round-trip tests' inputs."""
+(h5py, scipy.io.savemat, npTDMS, rosbags): inputs of the round-trip tests and of the
+reliability bench's ``format_file`` cases."""
 
 from __future__ import annotations
 
@@ -222,3 +223,14 @@ def write_ros2(run: SpecRun, folder: Path, storage: str = "sqlite3") -> Path:
             writer.write(connections[topic], ns, store.serialize_cdr(msg, msgtype))
     write_sidecar(_ros_records(run), folder)
     return folder
+
+
+#: format -> (writer of a run to a file or folder under ``folder``, channel map)
+WRITERS = {
+    "hdf5": (lambda run, folder: write_hdf5(run, folder / "run.h5"), None),
+    "mat5": (lambda run, folder: write_mat5(run, folder / "run.mat"), None),
+    "mat73": (lambda run, folder: write_mat73(run, folder / "run.mat"), None),
+    "tdms": (lambda run, folder: write_tdms(run, folder / "run.tdms"), None),
+    "rosbag1": (lambda run, folder: write_ros1(run, folder / "run.bag"), "spec_ros"),
+    "rosbag2": (lambda run, folder: write_ros2(run, folder / "bag2"), "spec_ros"),
+}
