@@ -75,14 +75,15 @@ def _stamp_ns(message, log_ns: int) -> int:
 
 
 def _field(path: Path, topic: str, spec: str, message, index: int) -> float:
-    """The number at ``spec`` (``wrench.force.x``, ``position[0]``, ``position[wheel]``) in ``message``."""
+    """The number at ``spec`` (``wrench.force.x``, ``position[wheel]``) in ``message``."""
     value = message
     for step in spec.split("."):
         match = _STEP.fullmatch(step)
         if match is None or not hasattr(value, match.group(1)):
             raise IngestError(path, f"{topic}.{spec}", f"message {index} "
                               f"({getattr(message, '__msgtype__', type(message).__name__)}) "
-                              f"has no field {step!r}")
+                              f"has no field {step!r} (a field is a message path such as "
+                              "wrench.force.x; the shipped map spec_ros reads the spec topics)")
         value = getattr(value, match.group(1))
         key = match.group(2)
         if key is not None:

@@ -56,7 +56,8 @@ class Run:
 
 def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> Run:
     """Read one run: a file or folder of any format ``ingest.formats`` recognises by content
-    (MCAP, HDF5, MATLAB, TDMS, ROS bags, CSV run folder), or a text log its channel map describes."""
+    (MCAP, HDF5, MATLAB, TDMS, ROS bags, CSV run folder), or a text log its channel map
+    describes."""
     path = Path(path)
     cmap = load_channel_map(channel_map)
     raw = _read_raw(path, cmap)

@@ -1,4 +1,5 @@
-"""``swtlab results --db URL [--csv FILE | --parquet FILE | --json]``: one row per run (docs/results.md)."""
+"""``swtlab results --db URL [--csv FILE | --parquet FILE | --json]``: one row per run
+(docs/results.md)."""
 
 from __future__ import annotations
 
