@@ -18,6 +18,7 @@ MAT73_HDF5_OFFSET = 512  # MATLAB v7.3: a 512-byte MATLAB header (user block), t
 TDMS_MAGIC = b"TDSm"
 ROSBAG1_MAGIC = b"#ROSBAG V2.0"
 ROS2_METADATA = "metadata.yaml"
+ROS_FORMATS = ("rosbag1", "rosbag2", "mcap_cdr")
 #: what ``sniff`` returns, one reader each
 FORMATS = ("mcap", "mcap_cdr", "hdf5", "mat5", "mat73", "tdms", "rosbag1", "rosbag2", "csv_run")
 
@@ -61,6 +62,14 @@ def sniff(path: Path) -> str:
                       "folders "
                       "(for a text log pass its channel map, e.g. --channel-map "
                       "cmu_3d_terramechanics)")
+
+
+def is_ros_bag(path: Path) -> bool:
+    """True for a ROS 1 bag, a ROS 2 bag folder or a CDR MCAP (False for text and the rest)."""
+    try:
+        return sniff(path) in ROS_FORMATS
+    except IngestError:
+        return False
 
 
 def _mcap_is_cdr(path: Path) -> bool:

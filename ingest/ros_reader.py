@@ -28,30 +28,15 @@ _EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
 
 def read_ros(path: Path, cmap: ChannelMap) -> RawRun:
     """The map's topics and message fields of one bag (file or ROS 2 folder)."""
-    from rosbags.highlevel import AnyReader
-
     path = Path(path)
     records = sidecar_records(path)
     stamps: dict[str, list[int]] = defaultdict(list)
     values: dict[str, dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
-    try:
-        with AnyReader([path]) as reader:
-            wanted = [c for c in reader.connections if c.topic in set(cmap.topics)]
-            for connection, log_ns, data in reader.messages(connections=wanted):
-                topic = connection.topic
-                message = reader.deserialize(data, connection.msgtype)
-                stamps[topic].append(_stamp_ns(message, log_ns))
-                for spec in cmap.channels_of(topic):
-                    values[topic][spec.field].append(
-                        _field(path, topic, spec.field, message, len(stamps[topic]) - 1))
-    except IngestError:
-        raise
-    except OSError as exc:
-        raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
-    except Exception as exc:  # noqa: BLE001 - rosbags raises many types for damaged bags
-        raise IngestError(path, None, f"corrupt or unreadable ROS bag ({type(exc).__name__}: "
-                          f"{exc}); the bag is damaged or cut short (try `rosbag reindex`)") \
-            from None
+    for topic, log_ns, message in _messages(path, set(cmap.topics)):
+        stamps[topic].append(_stamp_ns(message, log_ns))
+        for spec in cmap.channels_of(topic):
+            values[topic][spec.field].append(
+                _field(path, topic, spec.field, message, len(stamps[topic]) - 1))
     if not stamps:
         return RawRun(path=path, records=records, topics={})
     start_ns = _start_ns(path, records, stamps)
@@ -63,6 +48,50 @@ def read_ros(path: Path, cmap: ChannelMap) -> RawRun:
             t_s=(t_ns[order] - start_ns) * 1e-9,
             fields={k: np.asarray(v, dtype=np.float64)[order] for k, v in values[topic].items()})
     return RawRun(path=path, records=records, topics=topics)
+
+
+def read_ros_rows(path: Path, cmap: ChannelMap) -> RawRun:
+    """A delimited map's text log recorded in a bag: each message on the map's ``stream``
+    topic carries one row in its ``data`` array (std_msgs/Float64MultiArray), the columns in
+    the map's ``files.columns`` order; time from the map's time column, as for the text."""
+    path = Path(path)
+    rows = []
+    for _, _, message in _messages(path, {cmap.stream}):
+        row = np.asarray(getattr(message, "data", ()), dtype=np.float64).reshape(-1)
+        if len(row) != len(cmap.columns):
+            raise IngestError(path, cmap.stream, f"message {len(rows)} holds {len(row)} values, "
+                              f"the channel map {cmap.path.name} expects {len(cmap.columns)} "
+                              f"({', '.join(cmap.columns)})")
+        rows.append(row)
+    if not rows:
+        return RawRun(path=path, records=sidecar_records(path), topics={})
+    table = np.vstack(rows)
+    wanted = {cmap.time_column} | {c.field for c in cmap.channels}
+    fields = {name: table[:, i] for i, name in enumerate(cmap.columns) if name in wanted}
+    t = fields.pop(cmap.time_column)
+    return RawRun(path=path, records=sidecar_records(path),
+                  topics={cmap.stream: RawTopic(t_s=(t - t[0]) * cmap.time_scale_s,
+                                                fields=fields)})
+
+
+def _messages(path: Path, topics: set[str]):
+    """(topic, log time ns, decoded message) of the bag's messages on ``topics``, in log time
+    order; a damaged bag is one IngestError."""
+    from rosbags.highlevel import AnyReader
+
+    try:
+        with AnyReader([path]) as reader:
+            wanted = [c for c in reader.connections if c.topic in topics]
+            for connection, log_ns, data in reader.messages(connections=wanted):
+                yield connection.topic, log_ns, reader.deserialize(data, connection.msgtype)
+    except IngestError:
+        raise
+    except OSError as exc:
+        raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
+    except Exception as exc:  # noqa: BLE001 - rosbags raises many types for damaged bags
+        raise IngestError(path, None, f"corrupt or unreadable ROS bag ({type(exc).__name__}: "
+                          f"{exc}); the bag is damaged or cut short (try `rosbag reindex`)") \
+            from None
 
 
 def _stamp_ns(message, log_ns: int) -> int:

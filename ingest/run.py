@@ -15,10 +15,11 @@ from ingest.channel_map import ChannelMap, load_channel_map
 from ingest.checks import check_calibrated, check_topic
 from ingest.delimited_reader import read_delimited
 from ingest.errors import IngestError, Problem
-from ingest.formats import read_raw_file
+from ingest.formats import is_ros_bag, read_raw_file
 from ingest.metadata import RunMetadata, parse_metadata
 from ingest.raw import FrameIndex, RawRun
 from ingest.records import merged_records
+from ingest.ros_reader import read_ros_rows
 from ingest.timebase import (DROP_FACTOR, GAP_FACTOR, JITTER_LIMIT, StreamTiming, common_grid,
                              grid_mask, grid_size, stream_timing, to_grid)
 
@@ -85,6 +86,8 @@ def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:
     if not path.exists():
         raise IngestError(path, None, "no such file or folder")
     if cmap.format == "delimited":
+        if is_ros_bag(path):
+            return read_ros_rows(path, cmap)  # the text log's rows recorded in a bag
         if not path.is_file():
             raise IngestError(path, None, f"channel map {cmap.name} reads one text file per run")
         return read_delimited(path, cmap)

@@ -140,3 +140,35 @@ def test_unknown_bytes_and_folders(tmp_path):
     assert "not a run: unknown format" in _error(tmp_path / "x.dat").problem
     (tmp_path / "empty").mkdir()
     assert "not a run" in _error(tmp_path / "empty").problem
+
+
+def test_cmu_log_as_a_ros1_bag_reads_to_the_text_logs_channels(tmp_path, ingest_cmu_root):
+    """A CMU motion log recorded as a ROS 1 bag (rosbags writer; /cmu/motion,
+    std_msgs/Float64MultiArray, one row per message, log time from the host clock) through the
+    shipped CMU map gives the text log's channel table and metadata exactly."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    text = sorted((ingest_cmu_root / "raw").rglob("10_*_0_*.txt"))[0]
+    rows = np.loadtxt(text, delimiter=",", ndmin=2)
+    store = get_typestore(Stores.ROS1_NOETIC)
+    msgtype = "std_msgs/msg/Float64MultiArray"
+    Array = store.types[msgtype]
+    layout = store.types["std_msgs/msg/MultiArrayLayout"](dim=[], data_offset=0)
+    bag = tmp_path / text.parent.name / text.with_suffix(".bag").name
+    bag.parent.mkdir()
+    with Writer(bag) as writer:
+        connection = writer.add_connection("/cmu/motion", msgtype, typestore=store)
+        for row in rows:
+            writer.write(connection, int(round(row[6] * 1e9)),
+                         store.serialize_ros1(Array(layout=layout, data=row), msgtype))
+    assert sniff(bag) == "rosbag1"
+    from_text = ingest.read_run(text, "cmu_3d_terramechanics")
+    from_bag = ingest.read_run(bag, "cmu_3d_terramechanics")
+    assert from_bag.run_id.split("/")[-2:] == from_text.run_id.split("/")[-2:]
+    assert replace(from_bag.metadata, run=replace(from_bag.metadata.run, run_id="")) == \
+        replace(from_text.metadata, run=replace(from_text.metadata.run, run_id=""))
+    assert len(from_text.channels) > 1000
+    import pandas as pd
+
+    pd.testing.assert_frame_equal(from_bag.channels, from_text.channels, check_exact=True)
