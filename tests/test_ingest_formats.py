@@ -172,3 +172,50 @@ def test_cmu_log_as_a_ros1_bag_reads_to_the_text_logs_channels(tmp_path, ingest_
     import pandas as pd
 
     pd.testing.assert_frame_equal(from_bag.channels, from_text.channels, check_exact=True)
+
+
+def test_hdf5_root_attributes_and_sidecar_give_the_records(tmp_path, spec_run):
+    """Records as root attributes ``"<record>.<key>"``; the sidecar overrides the file."""
+    import h5py
+
+    run = fw.SpecRun(spec_run.topics, {})
+    path = fw.write_hdf5(run, tmp_path / "attrs.h5")
+    with h5py.File(path, "a") as f:
+        for name, record in spec_run.records.items():
+            if name != "calibration":
+                f.attrs.update({f"{name}.{k}": v for k, v in record.items()})
+        f.attrs["wheel.radius_m"] = 0.2  # a number, not text: read as a number
+    fw.write_sidecar(fw.SpecRun({}, {"run": {"load_N": "99.5"},
+                                     "calibration": spec_run.records["calibration"]}), path)
+    meta = ingest.read_run(path).metadata
+    assert meta.wheel.radius_m == 0.2 and meta.run.load_n == 99.5
+    assert meta.run.run_id == spec_run.records["run"]["run_id"]
+
+
+def test_tdms_without_time_or_waveform_names_the_channel(tmp_path, spec_run):
+    from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
+
+    path = tmp_path / "bare.tdms"
+    with TdmsWriter(path) as writer:
+        writer.write_segment([RootObject(), GroupObject("/tether/force"),
+                              ChannelObject("/tether/force", "dp", np.arange(5.0))])
+    err = _error(path)
+    assert err.channel == "/tether/force.dp" and "wf_increment" in err.problem
+
+
+def test_mat_topic_that_is_not_a_struct(tmp_path):
+    from scipy.io import savemat
+
+    savemat(tmp_path / "flat.mat", {"hub_wrench": np.arange(4.0)})
+    err = _error(tmp_path / "flat.mat")
+    assert err.channel == "/hub/wrench" and "must be a struct" in err.problem
+
+
+@pytest.mark.parametrize("fmt", ["hdf5", "mat73", "tdms", "rosbag2"])
+def test_swtlab_inspect_takes_the_format(fmt, tmp_path, spec_run, capsys):
+    from swtlab_cli.main import main
+
+    write, cmap = CASES[fmt]
+    path = write(spec_run, tmp_path)
+    assert main(["inspect", str(path), *(["--channel-map", cmap] if cmap else [])]) == 0
+    assert spec_run.records["run"]["run_id"] in capsys.readouterr().out
