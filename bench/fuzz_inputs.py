@@ -5,6 +5,7 @@ and CSV run folders; in-family, same writer as the spec) and real CMU motion log
 through their channel map (independent). Each case changes one of: MCAP bytes, one JSON
 block, one whole channel (scaled, negated, offset, flat, clipped, spiked, frozen), one
 metadata value, one CSV cell or line, one ``run.json`` value, one channel-map key,
+one channel or the bytes of the run written as HDF5, MATLAB, TDMS or a ROS bag,
 or cuts a CMU file short, to a value from a list of known-hostile ones (huge, tiny,
 non-finite, wrong-typed, nested, math text, paths outside the run) or a random one.
 ``case(seed, i)`` is the same input on every machine.
@@ -301,6 +302,46 @@ def _channel_map(rng) -> Case:
                 write)
 
 
+def _format_file(rng, run_id: str) -> Case:
+    """The run written as HDF5, MAT v5/v7.3, TDMS or a ROS bag (bench.format_files), then one
+    channel made hostile (non-finite, huge, one sample short) or the file's bytes damaged."""
+    from bench import format_files
+
+    fmt = _pick(rng, sorted(format_files.WRITERS))
+    writer, cmap = format_files.WRITERS[fmt]
+    run = format_files.read_spec_mcap(SAMPLE / f"{run_id}.mcap")
+    how = _pick(rng, ("channel", "bytes", "cut"))
+    topic = _pick(rng, sorted(run.topics))
+    field = _pick(rng, sorted(set(run.topics[topic]) - {"t_ns"}))
+    what = f"{run_id} as {fmt}: {how}"
+    if how == "channel":
+        values = run.topics[topic][field]
+        hostile = _pick(rng, ("nan", "inf", "huge", "short", "spike"))
+        if hostile == "short":
+            run.topics[topic][field] = values[:-1]
+        else:
+            value = {"nan": np.nan, "inf": np.inf, "huge": 1e308, "spike": 1e6}[hostile]
+            at = rng.integers(len(values), size=max(1, len(values) // int(rng.integers(1, 50))))
+            values[at] = value
+        what += f" {topic}.{field} {hostile}"
+    cut = float(rng.uniform(0.05, 0.95))
+    at = int(rng.integers(1 << 30))
+
+    def write(folder: Path):
+        path = writer(run, folder)
+        target = path if path.is_file() else max(
+            (p for p in path.iterdir() if p.suffix != ".yaml"), key=lambda p: p.stat().st_size)
+        data = bytearray(target.read_bytes())
+        if how == "cut":
+            del data[int(cut * len(data)):]
+        elif how == "bytes":
+            i = at % max(1, len(data) - 8)
+            data[i:i + 8] = bytes(b ^ 0xFF for b in data[i:i + 8])
+        target.write_bytes(bytes(data))
+        return path, cmap
+    return Case("format_file", what, write)
+
+
 def _cmu_file(rng) -> Case:
     source = _pick(rng, cmu_files())
     lines = source.read_text().splitlines(True)[:CMU_LINES]
@@ -324,7 +365,8 @@ def _cmu_file(rng) -> Case:
 
 #: case kinds and their weights
 KINDS = (("mcap_bytes", 2), ("json_block", 4), ("channel", 2), ("metadata", 4),
-         ("csv_cell", 2), ("run_json", 2), ("channel_map", 2), ("cmu_file", 1))
+         ("csv_cell", 2), ("run_json", 2), ("channel_map", 2), ("cmu_file", 1),
+         ("format_file", 2))
 
 
 def case(seed: int, index: int) -> Case:
@@ -347,4 +389,6 @@ def case(seed: int, index: int) -> Case:
         return _run_json(rng, _pick(rng, CSV_RUNS))
     if kind == "channel_map":
         return _channel_map(rng)
+    if kind == "format_file":
+        return _format_file(rng, _pick(rng, MCAP_RUNS))
     return _cmu_file(rng)

@@ -7,7 +7,12 @@ from pathlib import Path
 
 from ingest.channel_map import ChannelMap, load_channel_map
 from ingest.errors import IngestError
+from ingest.formats import ROS2_METADATA
 from ingest.run import Run, read_run
+
+
+#: run files found by extension (each is then read by its content, ingest.formats.sniff)
+RUN_SUFFIXES = (".mcap", ".h5", ".hdf5", ".hdf", ".mat", ".tdms", ".bag")
 
 
 @dataclass(frozen=True)
@@ -20,8 +25,9 @@ class CampaignRead:
 
 
 def find_runs(root: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> list[Path]:
-    """Run files/folders under ``root`` (sorted): ``.mcap`` files and folders holding ``run.json``
-    for the spec form; files matching the map's ``files.pattern`` for a delimited map."""
+    """Run files/folders under ``root`` (sorted): files with a RUN_SUFFIXES extension, folders
+    holding ``run.json`` (CSV form) or ``metadata.yaml`` (ROS 2 bag);
+    files matching the map's ``files.pattern`` for a delimited map."""
     root = Path(root)
     cmap = load_channel_map(channel_map)
     if not root.exists():
@@ -31,10 +37,12 @@ def find_runs(root: str | Path, channel_map: "str | Path | ChannelMap | None" = 
             return [root]
         return sorted(p for p in root.rglob(cmap.file_pattern or "*") if p.is_file())
     if root.is_file():
-        return [root] if root.suffix.lower() == ".mcap" else []
-    found = [p for p in root.rglob("*.mcap") if p.is_file()]
+        return [root] if root.suffix.lower() in RUN_SUFFIXES else []
+    bags = {p.parent for p in root.rglob(ROS2_METADATA)}
+    found = [p for p in root.rglob("*") if p.is_file() and p.suffix.lower() in RUN_SUFFIXES
+             and p.parent not in bags]
     found += [p.parent for p in root.rglob("run.json")]
-    return sorted(found)
+    return sorted(found + list(bags))
 
 
 def read_campaign(root: str | Path,

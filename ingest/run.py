@@ -13,13 +13,13 @@ from ingest.calibration import subtract_zero, to_canonical
 from ingest.canonical import CANONICAL, DERIVED, MEASURED, SUBSTITUTES, WRENCH_COLUMNS
 from ingest.channel_map import ChannelMap, load_channel_map
 from ingest.checks import check_calibrated, check_topic
-from ingest.csv_reader import read_csv_run
 from ingest.delimited_reader import read_delimited
 from ingest.errors import IngestError, Problem
-from ingest.mcap_reader import read_mcap
+from ingest.formats import is_ros_bag, read_raw_file
 from ingest.metadata import RunMetadata, parse_metadata
 from ingest.raw import FrameIndex, RawRun
 from ingest.records import merged_records
+from ingest.ros_reader import read_ros_rows
 from ingest.timebase import (DROP_FACTOR, GAP_FACTOR, JITTER_LIMIT, StreamTiming, common_grid,
                              grid_mask, grid_size, stream_timing, to_grid)
 
@@ -56,7 +56,9 @@ class Run:
 
 
 def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> Run:
-    """Read one run: a ``.mcap`` file, a CSV run folder, or a file a channel map describes."""
+    """Read one run: a file or folder of any format ``ingest.formats`` recognises by content
+    (MCAP, HDF5, MATLAB, TDMS, ROS bags, CSV run folder), or a text log its channel map
+    describes."""
     path = Path(path)
     cmap = load_channel_map(channel_map)
     raw = _read_raw(path, cmap)
@@ -84,16 +86,12 @@ def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:
     if not path.exists():
         raise IngestError(path, None, "no such file or folder")
     if cmap.format == "delimited":
+        if is_ros_bag(path):
+            return read_ros_rows(path, cmap)  # the text log's rows recorded in a bag
         if not path.is_file():
             raise IngestError(path, None, f"channel map {cmap.name} reads one text file per run")
         return read_delimited(path, cmap)
-    if path.is_file() and path.suffix.lower() == ".mcap":
-        return read_mcap(path, set(cmap.topics))
-    if path.is_dir() and (path / "run.json").is_file():
-        return read_csv_run(path, cmap)
-    raise IngestError(path, None, "not a run: expected a .mcap file or a folder holding run.json "
-                      "(for other files pass a channel map, e.g. "
-                      "--channel-map cmu_3d_terramechanics)")
+    return read_raw_file(path, cmap)
 
 
 def _coverage_problems(path: Path, raw: RawRun, cmap: ChannelMap) -> list[Problem]:

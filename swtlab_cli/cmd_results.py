@@ -1,4 +1,5 @@
-"""``swtlab results --db URL [--csv FILE | --json]``: one row per run (docs/results.md)."""
+"""``swtlab results --db URL [--csv FILE | --parquet FILE | --json]``: one row per run
+(docs/results.md)."""
 
 from __future__ import annotations
 
@@ -31,11 +32,14 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "window, and each quantity's mean, standard deviation, standard error and "
                     "uncertainty budget (u, u95 = k u, terms) in SI units (columns: "
                     "docs/results.md); runs that failed (status failed) with the stage, "
-                    "exception type and reason. Without --csv/--json, a summary table.")
+                    "exception type and reason. Without --csv/--parquet/--json, a summary "
+                    "table.")
     parser.add_argument("--db", required=True,
                         help="database URL or SQLite file path (read, never created or upgraded)")
     out = parser.add_mutually_exclusive_group()
     out.add_argument("--csv", type=Path, help="write every column to this CSV file")
+    out.add_argument("--parquet", type=Path,
+                     help="write every column to this Parquet file (pyarrow; keeps the dtypes)")
     out.add_argument("--json", action="store_true", help="every column as JSON records on stdout")
     instead = parser.add_mutually_exclusive_group()
     instead.add_argument("--towed", action="store_true",
@@ -58,6 +62,13 @@ def failed_rows(failures) -> pd.DataFrame:
         for f in failures], columns=["run_id", "status", "flags", "raw_file_path",
                                      "raw_file_sha256", "failure_stage", "failure_type",
                                      "failure_reason"])
+
+
+def write_parquet(frame: pd.DataFrame, path: Path) -> None:
+    """``frame`` to a Parquet file (pyarrow), atomically; ``pd.read_parquet`` gives it back
+    with its dtypes (pandas metadata in the file)."""
+    with atomic_file(path, "wb") as stream:
+        frame.to_parquet(stream, engine="pyarrow", index=False)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -94,10 +105,13 @@ def run(args: argparse.Namespace) -> int:
         table = table.assign(run_ids=table["run_ids"].map(" ".join))
         failed = failed.iloc[0:0]
     every = pd.concat([t for t in (table, failed) if len(t)], ignore_index=True)
-    if args.csv:
-        with atomic_file(args.csv, newline="") as stream:
-            every.to_csv(stream, index=False)
-        print(f"{len(every)} runs written to {args.csv}"
+    if args.csv or args.parquet:
+        if args.csv:
+            with atomic_file(args.csv, newline="") as stream:
+                every.to_csv(stream, index=False)
+        else:
+            write_parquet(every, args.parquet)
+        print(f"{len(every)} runs written to {args.csv or args.parquet}"
               + (f" ({len(failed)} failed)" if len(failed) else ""))
     elif args.json:
         print(every.to_json(orient="records", indent=1))

@@ -20,7 +20,7 @@ def test_five_hundred_mutated_runs_fail_cleanly_or_give_sound_results():
     assert faults == []
     # every kind of input was tried, and the mutations both break runs and leave some usable
     assert set(counts) == {"mcap_bytes", "json_block", "channel", "metadata", "csv_cell",
-                           "run_json", "channel_map", "cmu_file"}
+                           "run_json", "channel_map", "cmu_file", "format_file"}
     assert total["refused"] > 0.5 * INPUTS and total["ok"] + total["flagged"] > 0.1 * INPUTS
 
 

@@ -1,0 +1,156 @@
+"""ROS reader (rosbags): ROS 1 bags, ROS 2 bags (sqlite3 or MCAP storage), CDR-encoded MCAP.
+
+The map's topic is the ROS topic; its field is a path into the message: ``wrench.force.x``
+(WrenchStamped), ``position[0]`` or ``position[wheel_joint]`` (JointState, by index or by
+joint name), ``data`` (Float64), ``data[1]`` (Float64MultiArray), ``point.x`` (PointStamped).
+Time: the message's ``header.stamp`` when it has one, else the bag's log time; counted
+from ``run.started_at`` of the sidecar ``<name>.run.json`` when given, else from the
+earliest time stamp read. Metadata: the sidecar.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import defaultdict
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from ingest.channel_map import ChannelMap
+from ingest.errors import IngestError
+from ingest.raw import RawRun, RawTopic
+from ingest.structured import sidecar_records
+
+_STEP = re.compile(r"([A-Za-z_]\w*)(?:\[([^\]]+)\])?")
+_EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
+
+
+def read_ros(path: Path, cmap: ChannelMap) -> RawRun:
+    """The map's topics and message fields of one bag (file or ROS 2 folder)."""
+    path = Path(path)
+    records = sidecar_records(path)
+    stamps: dict[str, list[int]] = defaultdict(list)
+    values: dict[str, dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
+    for topic, log_ns, message in _messages(path, set(cmap.topics)):
+        stamps[topic].append(_stamp_ns(message, log_ns))
+        for spec in cmap.channels_of(topic):
+            values[topic][spec.field].append(
+                _field(path, topic, spec.field, message, len(stamps[topic]) - 1))
+    if not stamps:
+        return RawRun(path=path, records=records, topics={})
+    start_ns = _start_ns(path, records, stamps)
+    topics = {}
+    for topic, times in stamps.items():
+        t_ns = np.array(times, dtype=np.int64)
+        order = np.argsort(t_ns, kind="stable")
+        topics[topic] = RawTopic(
+            t_s=(t_ns[order] - start_ns) * 1e-9,
+            fields={k: np.asarray(v, dtype=np.float64)[order] for k, v in values[topic].items()})
+    return RawRun(path=path, records=records, topics=topics)
+
+
+def read_ros_rows(path: Path, cmap: ChannelMap) -> RawRun:
+    """A delimited map's text log recorded in a bag: each message on the map's ``stream``
+    topic carries one row in its ``data`` array (std_msgs/Float64MultiArray), the columns in
+    the map's ``files.columns`` order; time from the map's time column, as for the text."""
+    path = Path(path)
+    rows = []
+    for _, _, message in _messages(path, {cmap.stream}):
+        row = np.asarray(getattr(message, "data", ()), dtype=np.float64).reshape(-1)
+        if len(row) != len(cmap.columns):
+            raise IngestError(path, cmap.stream, f"message {len(rows)} holds {len(row)} values, "
+                              f"the channel map {cmap.path.name} expects {len(cmap.columns)} "
+                              f"({', '.join(cmap.columns)})")
+        rows.append(row)
+    if not rows:
+        return RawRun(path=path, records=sidecar_records(path), topics={})
+    table = np.vstack(rows)
+    wanted = {cmap.time_column} | {c.field for c in cmap.channels}
+    fields = {name: table[:, i] for i, name in enumerate(cmap.columns) if name in wanted}
+    t = fields.pop(cmap.time_column)
+    return RawRun(path=path, records=sidecar_records(path),
+                  topics={cmap.stream: RawTopic(t_s=(t - t[0]) * cmap.time_scale_s,
+                                                fields=fields)})
+
+
+def _messages(path: Path, topics: set[str]):
+    """(topic, log time ns, decoded message) of the bag's messages on ``topics``, in log time
+    order; a damaged bag is one IngestError."""
+    from rosbags.highlevel import AnyReader
+
+    try:
+        with AnyReader([path]) as reader:
+            wanted = [c for c in reader.connections if c.topic in topics]
+            for connection, log_ns, data in reader.messages(connections=wanted):
+                yield connection.topic, log_ns, reader.deserialize(data, connection.msgtype)
+    except IngestError:
+        raise
+    except OSError as exc:
+        raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
+    except Exception as exc:  # noqa: BLE001 - rosbags raises many types for damaged bags
+        raise IngestError(path, None, f"corrupt or unreadable ROS bag ({type(exc).__name__}: "
+                          f"{exc}); the bag is damaged or cut short (try `rosbag reindex`)") \
+            from None
+
+
+def _stamp_ns(message, log_ns: int) -> int:
+    header = getattr(message, "header", None)
+    stamp = getattr(header, "stamp", None)
+    if stamp is None:
+        return int(log_ns)
+    nsec = getattr(stamp, "nanosec", None)
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nsec if nsec is None else nsec)
+
+
+def _field(path: Path, topic: str, spec: str, message, index: int) -> float:
+    """The number at ``spec`` (``wrench.force.x``, ``position[wheel]``) in ``message``."""
+    value = message
+    for step in spec.split("."):
+        match = _STEP.fullmatch(step)
+        if match is None or not hasattr(value, match.group(1)):
+            raise IngestError(path, f"{topic}.{spec}", f"message {index} "
+                              f"({getattr(message, '__msgtype__', type(message).__name__)}) "
+                              f"has no field {step!r} (a field is a message path such as "
+                              "wrench.force.x; the shipped map spec_ros reads the spec topics)")
+        value = getattr(value, match.group(1))
+        key = match.group(2)
+        if key is not None:
+            value = _item(path, topic, spec, message, value, key, index)
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise IngestError(path, f"{topic}.{spec}", f"message {index}: not a number "
+                          f"({type(value).__name__})") from None
+
+
+def _item(path, topic, spec, message, array, key: str, index: int):
+    """``array[key]``: by position, or by joint name (JointState's ``name`` list)."""
+    if key.lstrip("-").isdigit():
+        position = int(key)
+    else:
+        names = list(getattr(message, "name", []))
+        if key not in names:
+            raise IngestError(path, f"{topic}.{spec}", f"message {index}: no joint {key!r} "
+                              f"(names: {', '.join(names) or 'none'})")
+        position = names.index(key)
+    if not -len(array) <= position < len(array):
+        raise IngestError(path, f"{topic}.{spec}", f"message {index} holds {len(array)} "
+                          f"values, no index {position}")
+    return array[position]
+
+
+def _start_ns(path: Path, records: dict, stamps: dict[str, list[int]]) -> int:
+    """``run.started_at`` (sidecar) in ns since the epoch, else the earliest stamp."""
+    started = records.get("run", {}).get("started_at")
+    if started is None:
+        return min(min(t) for t in stamps.values())
+    try:
+        when = datetime.fromisoformat(str(started).replace("Z", "+00:00"))
+    except ValueError:
+        raise IngestError(path, "run.started_at", f"{str(started)[:40]!r} is not an ISO 8601 "
+                          "time") from None
+    if when.tzinfo is None:
+        when = when.replace(tzinfo=timezone.utc)
+    delta = when - _EPOCH
+    return (delta.days * 86400 + delta.seconds) * 1_000_000_000 + delta.microseconds * 1000
