@@ -165,27 +165,24 @@ def _profiles_at(image: np.ndarray, center: tuple[float, float], angles: np.ndar
 def _soil_onset(energy: np.ndarray, center, angles, rough_px: float) -> float:
     """Radius where the soil texture starts for good on the soil-facing rays.
 
-    Median over rays of the local texture energy against the radius: the innermost radius
-    from which it stays above the midpoint (in log) of the wheel's and the soil's levels
-    for 8 px. A painted ring or tyre band inside the rim is a short burst, not the onset.
+    Median over rays of the local texture energy against the radius: just past the last
+    radius (before the soil 24 px out) where it is below the midpoint (in log) of the
+    wheel's and the soil's levels. A painted ring or tyre band inside the rim is a burst
+    followed by quiet again, not the onset.
     """
     radii = np.arange(max(rough_px - 6.0, 2.0), rough_px + 24.0, 0.5)
     prof = np.log(np.median(_profiles_at(energy, center, angles, radii), axis=0) + 1e-3)
     low, high = np.percentile(prof[:8], 50), np.median(prof[-16:])
-    above = prof > 0.5 * (low + high)
-    run = 16  # 8 px
-    for i in range(len(radii) - run):
-        if above[i:i + run].all():
-            return float(radii[i])
-    return rough_px
+    below = np.flatnonzero(prof[:-16] <= 0.5 * (low + high))
+    return float(radii[below[-1] + 1]) if len(below) else rough_px
 
 
 def _rim_edges(gray_blur: np.ndarray, center, angles, onset_px: float) -> np.ndarray:
-    """Per ray, the innermost intensity step from 1.5 px inside ``onset_px`` to 3 px outside:
+    """Per ray, the innermost intensity step from 1.5 px inside ``onset_px`` to 4.5 px outside:
     the first local peak of ``|dI/dr|`` reaching half the ray's largest there (the edges of
     soil grains beyond the rim can be stronger than the rim's own step), sub-pixel by a
     parabola through it."""
-    radii = onset_px + np.arange(-1.5, 3.25, 0.25)
+    radii = onset_px + np.arange(-1.5, 4.75, 0.25)
     d = np.abs(np.gradient(_profiles_at(gray_blur, center, angles, radii), axis=1))
     peak = np.zeros_like(d, bool)
     peak[:, 1:-1] = (d[:, 1:-1] >= d[:, :-2]) & (d[:, 1:-1] >= d[:, 2:])
@@ -223,16 +220,30 @@ def _fit_rim(gray: np.ndarray, rough: tuple[float, float, float],
     return center, r
 
 
+def _facing_soil(theta: np.ndarray, direction: int, soil_angles: np.ndarray | None) -> np.ndarray:
+    """Rays (model angle ``theta``) within 1 degree of a soil-facing image angle."""
+    if soil_angles is None or not len(soil_angles):
+        return np.ones(len(theta), bool)
+    bins = 360
+    hist = np.zeros(bins, bool)
+    hist[np.floor((soil_angles % (2 * np.pi)) / (2 * np.pi) * bins).astype(int) % bins] = True
+    hist = hist | np.roll(hist, 1) | np.roll(hist, -1)
+    image_angle = np.arctan2(np.cos(theta), direction * np.sin(theta)) % (2 * np.pi)
+    return hist[np.floor(image_angle / (2 * np.pi) * bins).astype(int) % bins]
+
+
 def _grousers(gray: np.ndarray, center: tuple[float, float], rim_px: float,
               direction: int, count: int | None,
-              height_px: float | None = None) -> tuple[int, float, float]:
+              height_px: float | None = None,
+              soil_angles: np.ndarray | None = None) -> tuple[int, float, float]:
     """Grouser count, angle and height from rays just outside the rim.
 
     A grouser is uniform along the ray where the soil is not: the spread of the
     intensity over ``rim + 1.5 .. rim + 4.5`` px (up to the grouser tip when its
     height is known), as a function of ``theta``, dips at
     each grouser; its harmonic at the grouser count (``swt.wheel``, else the strongest
-    harmonic when it is four times the median one) gives the phase. The height is the
+    harmonic when it is four times the median one) gives the phase; only the rays facing
+    soil count (above the soil surface a smooth background would dip too). The height is the
     median, over the grousers, of the run from the rim over which the intensity
     stays within 12 grey levels of the grouser's.
     """
@@ -240,7 +251,8 @@ def _grousers(gray: np.ndarray, center: tuple[float, float], rim_px: float,
     theta, values = _ray_samples(gray, center, radii, direction)
     depth = 7 if height_px is None else int(np.clip(2 * (height_px - 2.5), 7, values.shape[1]))
     spread = values[:, :depth].std(axis=1)
-    dip = np.median(spread) - spread
+    facing = _facing_soil(theta, direction, soil_angles)
+    dip = np.where(facing, np.median(spread[facing]) - spread, 0.0)
     spectrum = np.fft.rfft(dip)
     harmonics = np.arange(len(spectrum))
     band = (harmonics >= 3) & (harmonics <= 80)
@@ -277,7 +289,7 @@ def detect_wheel(gray: np.ndarray, direction: int = 1, grouser_count: int | None
     center, rim = _fit_rim(gray, (cx, cy, r), np.sort(angles))
     rim = radius_px or rim
     count, angle, height = _grousers(gray, center, rim, direction, grouser_count,
-                                     grouser_height_px)
+                                     grouser_height_px, angles)
     return WheelPose(center, rim, height, count, angle, np.sort(angles))
 
 
