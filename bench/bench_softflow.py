@@ -247,8 +247,8 @@ def decay_and_grousers(renders: int, decay_seeds: tuple[int, ...] = (5, 6, 7, 8,
 
 
 def second_renderer(wheels: int, runs: int) -> dict:
-    """The second renderer (written apart; seeds 500 on, not the tuning seeds 1-3 and 300-319): wheel centre
-    and radius without hints over random backgrounds, surfaces and axle positions; sled
+    """The second renderer (written apart; seeds 500 on, not the tuning seeds 1-3, 300-319): wheel
+    centre and radius without hints over random backgrounds, surfaces and axle positions; sled
     velocity, ``k`` and ``alpha3`` over the contact region (beta -160..-20 deg) where the
     component's rim velocity is at least 30 % of the travel velocity."""
     centre, radius = [], []

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import ndimage, stats
+from scipy import stats
 
 N_RAYS = 720
 MASK_MARGIN_PX = 8.0  # soil kept this far from the grouser tips (texture window, blur)

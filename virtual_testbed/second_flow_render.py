@@ -1,4 +1,4 @@
-"""A second side-camera renderer, written apart from ``flow_render`` (no shared code): swtlab issue 21.
+"""A second side-camera renderer, written apart from ``flow_render`` (no shared code; issue 21).
 
 What differs from the first renderer, on purpose:
 
@@ -138,7 +138,8 @@ def _wall_pattern(x_world: np.ndarray, y: np.ndarray, rng_phase: np.ndarray) -> 
     return np.clip(grain - 0.4 * seam, 0, 1)
 
 
-def render_second(scene: SecondScene, n_frames: int = 6) -> tuple[list[np.ndarray], np.ndarray, dict]:
+def render_second(scene: SecondScene,
+                  n_frames: int = 6) -> tuple[list[np.ndarray], np.ndarray, dict]:
     """Frames (uint8, grey, JPEG-decoded), their times and the truth."""
     if scene.background not in BACKGROUNDS:
         raise ValueError(f"background {scene.background!r}; known: {BACKGROUNDS}")
@@ -233,8 +234,8 @@ def _truth(scene: SecondScene) -> dict:
 
 
 def write_second(scene: SecondScene, folder: str | Path, n_frames: int = 6) -> Path:
-    """``camera_side/<t_ns>.png`` (the JPEG-damaged frames, stored losslessly) and a ``run.json`` (scale, direction, no wheel hints); the truth
-    to ``second_flow_truth.json`` beside them."""
+    """``camera_side/<t_ns>.png`` (the JPEG-damaged frames, stored losslessly) and a
+    ``run.json`` (scale, direction, no wheel hints); the truth to ``second_flow_truth.json``."""
     folder = Path(folder)
     (folder / "camera_side").mkdir(parents=True, exist_ok=True)
     frames, times, truth = render_second(scene, n_frames)

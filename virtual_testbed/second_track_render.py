@@ -108,8 +108,8 @@ def render_second_track(scene: SecondTrackScene) -> tuple[np.ndarray, dict]:
         prof = _mark_profile(scene, rng, u_grid, u.max() - u.min() + 0.02)
         grey = grey + 55 * np.interp(u, u_grid, prof) * across
     yy, xx = np.mgrid[0:h, 0:w] / max(w, h)
-    light = 1 + scene.light_unevenness * (0.5 * (xx - 0.5) + 0.3 * np.sin(3 * yy + rng.uniform(0, 6))
-                                          * np.cos(2 * xx + rng.uniform(0, 6)))
+    wave = np.sin(3 * yy + rng.uniform(0, 6)) * np.cos(2 * xx + rng.uniform(0, 6))
+    light = 1 + scene.light_unevenness * (0.5 * (xx - 0.5) + 0.3 * wave)
     img = grey * light
     if scene.blur_px:
         img = cv2.GaussianBlur(img, (0, 0), scene.blur_px)
@@ -135,5 +135,6 @@ def random_second_track(seed: int, slip: float, size_px: tuple[int, int] = (640,
                             erased_fraction=float(rng.uniform(0, 0.15)),
                             smeared_fraction=float(rng.uniform(0, 0.2)),
                             light_unevenness=float(rng.uniform(0.1, 0.4)),
-                            noise_std=float(rng.uniform(1, 4)), blur_px=float(rng.uniform(0.3, 1.2)),
+                            noise_std=float(rng.uniform(1, 4)),
+                            blur_px=float(rng.uniform(0.3, 1.2)),
                             seed=seed)
