@@ -292,8 +292,10 @@ def second_renderer(wheels: int, runs: int) -> dict:
            "sled_rel_error_max": float(np.max(sled)) if sled else None}
     for name, err in (("k", np.array(k_err)), ("alpha3", np.array(a3_err))):
         if len(err):
-            out[f"{name}_median"] = float(np.median(err))
-            out[f"{name}_p95"] = float(np.percentile(err, 95))
+            out[f"{name}_bins"] = len(err)
+            out[f"{name}_not_fitted"] = int(np.sum(~np.isfinite(err)))
+            out[f"{name}_median"] = float(np.median(err))  # unfitted bins count as failures
+            out[f"{name}_p95"] = float(np.percentile(np.minimum(err, 1e3), 95))
             out[f"{name}_within_5pct"] = float(np.mean(err <= 0.05))
     print("second renderer:", {k: round(v, 4) if isinstance(v, float) else v
                                for k, v in out.items()})
