@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from softflow.alpha12 import fit_alpha12, rates_and_sigmas
@@ -23,7 +24,8 @@ from softflow.flow_engine import MeanField, average_flow
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
 from softflow.volumetric_strain import strain_by_beta
-from softflow.wheel_detect import MASK_MARGIN_PX, WheelPose, soil_mask, track_wheel
+from softflow.wheel_detect import (MASK_MARGIN_PX, WheelPose, smooth_pixels, soil_mask,
+                                   track_wheel)
 
 #: profiles start this far outside the grouser tips: the soil mask's margin plus the 4 px
 #: reach of the decay-rate flow window (closer, the windows are one-sided and flatten the
@@ -118,8 +120,12 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
         raise ValueError("need at least two frames")
     poses = track_wheel(frames, direction, wheel_center_px, wheel_radius_px, grouser_count,
                         grouser_height_px)
+    # no soil where the first frame is smooth (sky-like background, sled frame above the soil
+    # surface): out of the flow and the profiles, 4 px beyond (the texture window)
+    textured = ~cv2.dilate(smooth_pixels(frames[0]).astype(np.uint8), np.ones((9, 9), np.uint8)
+                           ).astype(bool)
     masks = [soil_mask(frames[0].shape, poses[k]) & soil_mask(frames[0].shape, poses[k + 1])
-             for k in range(len(frames) - 1)]
+             & textured for k in range(len(frames) - 1)]
     mean = average_flow(frames, np.asarray(t_s, float), masks, engine)
     center = tuple(np.mean([p.center_px for p in poses], axis=0))
     r_px, beta, theta = polar_coordinates(frames[0].shape, center, direction)

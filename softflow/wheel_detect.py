@@ -57,6 +57,12 @@ def _smooth_pixels(gray: np.ndarray, window_px: int) -> np.ndarray:
     return scaled < thr
 
 
+def smooth_pixels(gray: np.ndarray) -> np.ndarray:
+    """Non-textured pixels (7 px window, Otsu), opened by 5 px: wheel, smooth background."""
+    return cv2.morphologyEx(_smooth_pixels(gray, 7).astype(np.uint8), cv2.MORPH_OPEN,
+                            np.ones((5, 5), np.uint8)).astype(bool)
+
+
 def _soil_boundary_points(smooth: np.ndarray) -> np.ndarray:
     """(x, y) of smooth pixels with a textured 4-neighbour and soil beyond: textured 6, 12 and
     20 px out along the boundary's normal (so not the edge of a painted ring or tyre band,
@@ -99,8 +105,7 @@ def rough_circle(gray: np.ndarray, seed: int = 0) -> tuple[float, float, float, 
     frame): they are no circle, so they do not take the centre away from the axle. The
     points lie a few pixels inside the rim (texture window): the radius is rough.
     """
-    smooth = cv2.morphologyEx(_smooth_pixels(gray, 7).astype(np.uint8), cv2.MORPH_OPEN,
-                              np.ones((5, 5), np.uint8)).astype(bool)
+    smooth = smooth_pixels(gray)
     pts = _soil_boundary_points(smooth)
     if len(pts) < 30:
         raise WheelNotFoundError("no smooth (non-soil) region in the frame")
