@@ -9,6 +9,8 @@ from dataclasses import replace
 import numpy as np
 
 from softflow.track_slip import NoPeriodicMarksError, measure_track_slip
+from virtual_testbed.second_track_render import (SecondTrackScene, random_second_track,
+                                                 render_second_track)
 from virtual_testbed.track_render import mark_spacing_m, random_nuisance, render_track
 
 RADIUS_M, GROUSERS, HEIGHT_M = 0.125, 12, 0.0092  # BB2-like wheel
@@ -84,7 +86,57 @@ def _radius() -> list[dict]:
     return rows
 
 
+def _baseline_s() -> float:
+    """Seconds of a fixed workload (ten 1024 x 1024 float FFTs, one thread): photo times are
+    also given as a ratio to it, so a busy machine's numbers can be compared."""
+    a = np.random.default_rng(0).standard_normal((1024, 1024))
+    start = time.perf_counter()
+    for _ in range(10):
+        np.fft.rfft2(a)
+    return time.perf_counter() - start
+
+
+def _second(count: int) -> dict:
+    """Second renderer (written apart): jittered, erased and smeared marks, uneven light,
+    rotation, keystone, JPEG q80; seeds 80 000 on, slip evenly over 0-0.8; mark-free photos;
+    seconds per photo with OpenCV on one thread."""
+    import cv2
+
+    cv2.setNumThreads(1)
+    errors_pp, seconds = [], []
+    for i, slip in enumerate(np.linspace(0.0, 0.8, count)):
+        scene = random_second_track(80_000 + i, float(slip))
+        image, truth = render_second_track(scene)
+        start = time.perf_counter()
+        try:
+            r = measure_track_slip(image, scene.radius_m, scene.grousers, px_per_m=scene.px_per_m)
+            errors_pp.append(100 * abs(r.slip - truth["slip"]))
+        except NoPeriodicMarksError:
+            errors_pp.append(np.inf)
+        seconds.append(time.perf_counter() - start)
+    refused = 0
+    for i in range(max(count // 10, 3)):
+        image, _ = render_second_track(SecondTrackScene(marks=False, seed=90_000 + i))
+        try:
+            measure_track_slip(image, 0.125, 12, px_per_m=700.0)
+        except NoPeriodicMarksError:
+            refused += 1
+    err = np.array(errors_pp)
+    base = _baseline_s()
+    out = {"renders": count, "refused": int(np.sum(~np.isfinite(err))),
+           "within_0p5pp": float(np.mean(err <= 0.5)),
+           "median_abs_error_pp": float(np.median(err)),
+           "p95_abs_error_pp": float(np.percentile(err, 95)),
+           "mark_free": max(count // 10, 3), "mark_free_refused": refused,
+           "median_seconds_one_thread": float(np.median(seconds)),
+           "baseline_seconds": base, "photo_over_baseline": float(np.median(seconds) / base)}
+    print("second renderer:", {k: round(v, 4) if isinstance(v, float) else v
+                               for k, v in out.items()})
+    return out
+
+
 def main(quick: bool = False) -> dict:
-    return {"accuracy": _accuracy(30 if quick else 200),
+    return {"second_renderer": _second(10 if quick else 100),
+            "accuracy": _accuracy(30 if quick else 200),
             "refusals": _refusals(6 if quick else 40),
             "radius": _radius()}

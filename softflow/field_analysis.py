@@ -14,15 +14,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 
 from softflow.alpha12 import fit_alpha12, rates_and_sigmas
 from softflow.decay_fit import DecayFit, fit_decay
+from softflow.flow_checks import check_contact_fits, check_sled_velocity, fit_reason
 from softflow.flow_engine import MeanField, average_flow
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
 from softflow.volumetric_strain import strain_by_beta
-from softflow.wheel_detect import MASK_MARGIN_PX, WheelPose, soil_mask, track_wheel
+from softflow.wheel_detect import (MASK_MARGIN_PX, WheelPose, smooth_pixels, soil_mask,
+                                   track_wheel)
 
 #: profiles start this far outside the grouser tips: the soil mask's margin plus the 4 px
 #: reach of the decay-rate flow window (closer, the windows are one-sided and flatten the
@@ -53,6 +56,8 @@ class FlowResult:
     eps_vol_p: np.ndarray | None = None  # per beta bin, compression positive
     eps_source: str | None = None  # "given" or "estimated"
     eps_depth_m: float | None = None  # estimated: taken this far outside the wheel
+    radial_reason: list = field(default_factory=list)  # per bin: why no k (None: fitted)
+    tangential_reason: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         p0 = self.poses[0]
@@ -77,14 +82,22 @@ class FlowResult:
             "per_beta": [
                 {"beta_deg": float(np.rad2deg(b)),
                  "k": r.to_dict() if r else None,
+                 "k_reason": rr,
                  "alpha3": t.to_dict() if t else None,
+                 "alpha3_reason": tr,
                  "eps_vol_p": None if np.isnan(e) else float(e)}
-                for b, r, t, e in zip(self.beta_rad, self.radial, self.tangential, eps)],
+                for b, r, t, e, rr, tr in zip(self.beta_rad, self.radial, self.tangential, eps,
+                                              self._reasons(self.radial_reason),
+                                              self._reasons(self.tangential_reason))],
             "alpha1_alpha2": self.alpha12,
             "eps_vol_p_source": self.eps_source,
             "eps_vol_p_depth_m": self.eps_depth_m,
             "grouser_model": self.grouser,
         }
+
+
+    def _reasons(self, reasons: list) -> list:
+        return reasons or [None] * len(self.beta_rad)
 
 
 def _rates(fits: list[DecayFit | None]) -> np.ndarray:
@@ -107,13 +120,24 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
         raise ValueError("need at least two frames")
     poses = track_wheel(frames, direction, wheel_center_px, wheel_radius_px, grouser_count,
                         grouser_height_px)
+    # no soil where the first frame is smooth (sky-like background, sled frame above the soil
+    # surface): out of the flow and the profiles, 4 px beyond (the texture window)
+    textured = ~cv2.dilate(smooth_pixels(frames[0]).astype(np.uint8), np.ones((9, 9), np.uint8)
+                           ).astype(bool)
     masks = [soil_mask(frames[0].shape, poses[k]) & soil_mask(frames[0].shape, poses[k + 1])
-             for k in range(len(frames) - 1)]
+             & textured for k in range(len(frames) - 1)]
     mean = average_flow(frames, np.asarray(t_s, float), masks, engine)
     center = tuple(np.mean([p.center_px for p in poses], axis=0))
     r_px, beta, theta = polar_coordinates(frames[0].shape, center, direction)
     v_cam = mean.velocity_px_per_s / px_per_m
-    sled = -far_field_velocity(v_cam, r_px)
+    lowest = max(p.center_px[1] + p.radius_px + p.grouser_height_px for p in poses)
+    # below the wheel there is soil, whatever lies above its surface (bin wall, sled frame)
+    under = np.arange(frames[0].shape[0])[:, None] > lowest + MASK_MARGIN_PX
+    if under.sum() < 0.05 * frames[0].shape[0]:  # too few rows below the wheel: all of them
+        under = np.ones_like(under)
+    far, spread = far_field_velocity(v_cam, r_px, np.broadcast_to(under, r_px.shape))
+    sled = -far
+    check_sled_velocity(sled, spread, direction)
     v_r, v_t = resolve(v_cam + sled, theta, direction)
     rim = poses[0].radius_px
     r_min = rim + poses[0].grouser_height_px + FIT_START_PX
@@ -122,12 +146,18 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
     prof_r = profiles(v_r, r_px, beta, centres, width, r_min)
     prof_t = profiles(v_t, r_px, beta, centres, width, r_min)
     fit = lambda p: fit_decay((p[0] - rim) / px_per_m, p[1], p[2])  # noqa: E731
-    radial = [fit(p) for p in prof_r]
+    speed = float(np.hypot(*sled))
+    radial, radial_reason = _checked([fit(p) for p in prof_r], prof_r,
+                                     np.abs(np.cos(centres)))  # |sin theta|
     tangential = [fit(p) for p in prof_t]
+    tangential, tangential_reason = _checked(
+        tangential, prof_t, [abs(f.amplitude) / speed if f else 0.0 for f in tangential])
+    check_contact_fits(centres, radial, tangential)
     result = FlowResult(px_per_m, np.asarray(t_s, float),
                         frame_range or (0, len(frames) - 1), poses, mean,
                         (float(sled[0]), float(sled[1])), centres, radial, tangential,
-                        prof_r, prof_t, engine=engine, source=source)
+                        prof_r, prof_t, engine=engine, source=source,
+                        radial_reason=radial_reason, tangential_reason=tangential_reason)
     if eps_vol_by_beta is not None:
         result.eps_vol_p, result.eps_source = np.asarray(eps_vol_by_beta, float), "given"
     else:
@@ -144,6 +174,12 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
     if poses[0].grouser_count and poses[0].grouser_height_px > 0:
         result.grouser = _grouser_selection(result, frames[0].shape, direction, r_min)
     return result
+
+
+def _checked(fits: list, profs: list, rim_fraction) -> tuple[list, list]:
+    """Fits kept where :func:`softflow.flow_checks.fit_reason` finds nothing, and the reasons."""
+    reasons = [fit_reason(f, len(p[0]), float(q)) for f, p, q in zip(fits, profs, rim_fraction)]
+    return [None if r else f for f, r in zip(fits, reasons)], reasons
 
 
 def _grouser_selection(result: FlowResult, shape: tuple[int, int], direction: int,

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from softflow.flow_checks import FlowMeasurementError
+
 
 def polar_coordinates(shape: tuple[int, int], center_px: tuple[float, float],
                       direction: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -35,12 +37,17 @@ def resolve(velocity_xy: np.ndarray, theta: np.ndarray,
     return travel * s + down * c, travel * c - down * s
 
 
-def far_field_velocity(velocity_xy: np.ndarray, radius_px: np.ndarray) -> np.ndarray:
-    """Median camera-frame velocity of the outer 15 % (by radius) of the valid soil."""
-    ok = np.isfinite(velocity_xy[..., 0])
+def far_field_velocity(velocity_xy: np.ndarray, radius_px: np.ndarray,
+                       usable: np.ndarray) -> tuple[np.ndarray, float]:
+    """Median camera-frame velocity of the outer 15 % (by radius) of the valid ``usable``
+    pixels, and the spread of its x part (IQR / 1.349)."""
+    ok = np.isfinite(velocity_xy[..., 0]) & usable
+    if ok.sum() < 50:
+        raise FlowMeasurementError("no far-field soil: fewer than 50 valid flow vectors")
     cut = np.quantile(radius_px[ok], 0.85)
-    far = ok & (radius_px >= cut)
-    return np.median(velocity_xy[far], axis=0)
+    far = velocity_xy[ok & (radius_px >= cut)]
+    q1, q3 = np.percentile(far[:, 0], [25, 75])
+    return np.median(far, axis=0), float((q3 - q1) / 1.349)
 
 
 def beta_bins(width_deg: float = 10.0) -> np.ndarray:

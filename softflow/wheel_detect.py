@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import ndimage, stats
+from scipy import stats
 
 N_RAYS = 720
 MASK_MARGIN_PX = 8.0  # soil kept this far from the grouser tips (texture window, blur)
@@ -40,6 +40,7 @@ class WheelPose:
     grouser_height_px: float  # 0 when no grousers were seen
     grouser_count: int
     grouser_angle_rad: float  # theta of grouser 0 is -grouser_angle_rad (mod pitch)
+    soil_angles_rad: np.ndarray | None = None  # image angles of the rays facing the soil
 
 
 class WheelNotFoundError(ValueError):
@@ -56,35 +57,88 @@ def _smooth_pixels(gray: np.ndarray, window_px: int) -> np.ndarray:
     return scaled < thr
 
 
-def smooth_region(gray: np.ndarray) -> np.ndarray:
-    """Boolean mask of the non-textured region (7 px window) that covers most once its
-    holes are filled: a painted ring on the wheel can split it into an inner disc and an
-    outer annulus, and the annulus, filled, is the whole wheel."""
-    smooth = cv2.morphologyEx(_smooth_pixels(gray, 7).astype(np.uint8), cv2.MORPH_OPEN,
-                              np.ones((5, 5), np.uint8))
-    labels, n = ndimage.label(smooth)
-    if n == 0:
+def smooth_pixels(gray: np.ndarray) -> np.ndarray:
+    """Non-textured pixels (7 px window, Otsu), opened by 5 px: wheel, smooth background."""
+    return cv2.morphologyEx(_smooth_pixels(gray, 7).astype(np.uint8), cv2.MORPH_OPEN,
+                            np.ones((5, 5), np.uint8)).astype(bool)
+
+
+def _soil_boundary_points(smooth: np.ndarray) -> np.ndarray:
+    """(x, y) of smooth pixels with a textured 4-neighbour and soil beyond: textured 6, 12 and
+    20 px out along the boundary's normal (so not the edge of a painted ring or tyre band,
+    nor where the wheel meets a smooth background)."""
+    inner = cv2.erode(smooth.astype(np.uint8), np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]],
+                                                        np.uint8))
+    ys, xs = np.nonzero(smooth & ~inner.astype(bool))
+    level = cv2.GaussianBlur(smooth.astype(np.float32), (0, 0), 2.0)
+    gy, gx = np.gradient(level)
+    nx, ny = -gx[ys, xs], -gy[ys, xs]  # towards the textured side
+    norm = np.hypot(nx, ny) + 1e-9
+    nx, ny = nx / norm, ny / norm
+    h, w = smooth.shape
+    soil = np.ones(len(xs), bool)
+    for d in (6.0, 12.0, 20.0):
+        qx = np.clip(np.rint(xs + d * nx).astype(int), 0, w - 1)
+        qy = np.clip(np.rint(ys + d * ny).astype(int), 0, h - 1)
+        soil &= ~smooth[qy, qx]
+    return np.column_stack([xs[soil], ys[soil]]).astype(np.float64)
+
+
+def _circle_through(p: np.ndarray) -> tuple[float, float, float] | None:
+    (x1, y1), (x2, y2), (x3, y3) = p
+    d = 2 * (x1 * (y2 - y3) + x2 * (y3 - y1) + x3 * (y1 - y2))
+    if abs(d) < 1e-9:
+        return None
+    s1, s2, s3 = x1 * x1 + y1 * y1, x2 * x2 + y2 * y2, x3 * x3 + y3 * y3
+    cx = (s1 * (y2 - y3) + s2 * (y3 - y1) + s3 * (y1 - y2)) / d
+    cy = (s1 * (x3 - x2) + s2 * (x1 - x3) + s3 * (x2 - x1)) / d
+    return cx, cy, float(np.hypot(x1 - cx, y1 - cy))
+
+
+def rough_circle(gray: np.ndarray, seed: int = 0) -> tuple[float, float, float, np.ndarray]:
+    """Centre, radius and inlier boundary points of the wheel's edge against the soil.
+
+    RANSAC (Fischler & Bolles 1981, Comm. ACM 24) over the boundary of the smooth pixels
+    (5 px opening): the circle of radius 8-60 % of the shorter image side, interior at
+    least 80 % smooth, that the most boundary points lie within 1.5 px of. The boundary
+    also holds the soil surface and whatever smooth lies above it (sky, bin wall, sled
+    frame): they are no circle, so they do not take the centre away from the axle. The
+    points lie a few pixels inside the rim (texture window): the radius is rough.
+    """
+    smooth = smooth_pixels(gray)
+    pts = _soil_boundary_points(smooth)
+    if len(pts) < 30:
         raise WheelNotFoundError("no smooth (non-soil) region in the frame")
-    sizes = ndimage.sum(smooth, labels, index=np.arange(1, n + 1))
-    best, best_area = None, 0
-    for label in 1 + np.flatnonzero(sizes >= 0.1 * sizes.max()):
-        filled = ndimage.binary_fill_holes(labels == label)
-        if filled.sum() > best_area:
-            best, best_area = filled, int(filled.sum())
-    return best
+    rng = np.random.default_rng(seed)
+    if len(pts) > 3000:
+        pts = pts[rng.choice(len(pts), 3000, replace=False)]
+    h, w = gray.shape
+    r_lo, r_hi = 0.08 * min(h, w), 0.6 * min(h, w)
+    best, best_n = None, 0
+    for _ in range(1500):
+        c = _circle_through(pts[rng.choice(len(pts), 3, replace=False)])
+        if c is None or not r_lo < c[2] < r_hi:
+            continue
+        n = int(np.sum(np.abs(np.hypot(pts[:, 0] - c[0], pts[:, 1] - c[1]) - c[2]) < 1.5))
+        if n > best_n and _smooth_inside(smooth, c) > 0.8:
+            best, best_n = c, n
+    if best is None or best_n < 0.15 * 2 * np.pi * best[2]:
+        raise WheelNotFoundError("no circular smooth region (wheel) found in the frame")
+    near = np.abs(np.hypot(pts[:, 0] - best[0], pts[:, 1] - best[1]) - best[2]) < 2.5
+    cx, cy, r = _kasa_circle(pts[near, 0], pts[near, 1])
+    return cx, cy, r, pts[near]
 
 
-def _edge_radii(mask: np.ndarray, center: tuple[float, float], r_max: float,
-                direction: int) -> tuple[np.ndarray, np.ndarray]:
-    theta = np.linspace(-np.pi, np.pi, N_RAYS, endpoint=False)
-    radii = np.arange(1.0, r_max, 0.5)
-    x = center[0] + direction * np.sin(theta)[:, None] * radii[None, :]
-    y = center[1] + np.cos(theta)[:, None] * radii[None, :]
-    inside = cv2.remap(mask.astype(np.float32), x.astype(np.float32), y.astype(np.float32),
-                       cv2.INTER_LINEAR, borderValue=0.0) > 0.5
-    first_out = np.argmax(~inside, axis=1)
-    r_edge = np.where(inside.all(axis=1), np.nan, radii[first_out])
-    return theta, r_edge
+def _smooth_inside(smooth: np.ndarray, c: tuple[float, float, float]) -> float:
+    """Fraction of smooth pixels on 3 rings inside the circle (those in the frame)."""
+    ang = np.linspace(0, 2 * np.pi, 90, endpoint=False)
+    x = np.concatenate([c[0] + f * c[2] * np.cos(ang) for f in (0.4, 0.7, 0.9)])
+    y = np.concatenate([c[1] + f * c[2] * np.sin(ang) for f in (0.4, 0.7, 0.9)])
+    h, w = smooth.shape
+    ok = (x >= 0) & (x < w - 1) & (y >= 0) & (y < h - 1)
+    if ok.sum() < 90:
+        return 0.0
+    return float(smooth[np.rint(y[ok]).astype(int), np.rint(x[ok]).astype(int)].mean())
 
 
 def _kasa_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
@@ -104,29 +158,97 @@ def _ray_samples(gray: np.ndarray, center: tuple[float, float], radii: np.ndarra
     return theta, values
 
 
-def _refine_rim(gray: np.ndarray, center: tuple[float, float], rough_px: float,
-                direction: int) -> float:
-    """The rim edge: peak of the median over rays of ``|dI/dr|`` near the smooth region's edge.
+def _profiles_at(image: np.ndarray, center: tuple[float, float], angles: np.ndarray,
+                 radii: np.ndarray) -> np.ndarray:
+    """Bilinear samples of ``image`` on rays at image angles ``angles`` (atan2(dy, dx))."""
+    x = center[0] + np.cos(angles)[:, None] * radii[None, :]
+    y = center[1] + np.sin(angles)[:, None] * radii[None, :]
+    return cv2.remap(image, x.astype(np.float32), y.astype(np.float32), cv2.INTER_LINEAR,
+                     borderMode=cv2.BORDER_REPLICATE)
 
-    The smooth-region edge lies a few pixels inside the rim (texture window); the
-    wheel/soil boundary is the strongest radial step common to all rays.
+
+def _soil_onset(energy: np.ndarray, center, angles, rough_px: float) -> float:
+    """Radius where the soil texture starts for good on the soil-facing rays.
+
+    Median over rays of the local texture energy against the radius: just past the last
+    radius (before the soil 24 px out) where it is below the midpoint (in log) of the
+    wheel's and the soil's levels. A painted ring or tyre band inside the rim is a burst
+    followed by quiet again, not the onset.
     """
-    radii = rough_px + np.arange(-2.0, 7.0, 0.5)  # the smooth edge lies 3-4 px inside
-    _, values = _ray_samples(gray, center, radii, direction)
-    step = np.median(np.abs(np.diff(values, axis=1)), axis=0)
-    return float(radii[int(np.argmax(step))] + 0.25)  # diff i lies between radii i and i + 1
+    radii = np.arange(max(rough_px - 6.0, 2.0), rough_px + 24.0, 0.5)
+    prof = np.log(np.median(_profiles_at(energy, center, angles, radii), axis=0) + 1e-3)
+    low, high = np.percentile(prof[:8], 50), np.median(prof[-16:])
+    below = np.flatnonzero(prof[:-16] <= 0.5 * (low + high))
+    return float(radii[below[-1] + 1]) if len(below) else rough_px
+
+
+def _rim_edges(gray_blur: np.ndarray, center, angles, onset_px: float) -> np.ndarray:
+    """Per ray, the innermost intensity step from 1.5 px inside ``onset_px`` to 4.5 px outside:
+    the first local peak of ``|dI/dr|`` reaching half the ray's largest there (the edges of
+    soil grains beyond the rim can be stronger than the rim's own step), sub-pixel by a
+    parabola through it."""
+    radii = onset_px + np.arange(-1.5, 4.75, 0.25)
+    d = np.abs(np.gradient(_profiles_at(gray_blur, center, angles, radii), axis=1))
+    peak = np.zeros_like(d, bool)
+    peak[:, 1:-1] = (d[:, 1:-1] >= d[:, :-2]) & (d[:, 1:-1] >= d[:, 2:])
+    peak &= d >= 0.5 * d.max(axis=1, keepdims=True)
+    i = np.clip(np.argmax(peak, axis=1), 1, len(radii) - 2)
+    rows = np.arange(len(angles))
+    a, b, c = d[rows, i - 1], d[rows, i], d[rows, i + 1]
+    den = a - 2 * b + c
+    off = np.where(np.abs(den) > 1e-9, 0.5 * (a - c) / np.where(den == 0, 1, den), 0.0)
+    return radii[i] + 0.25 * np.clip(off, -1, 1)
+
+
+def _fit_rim(gray: np.ndarray, rough: tuple[float, float, float],
+             angles: np.ndarray) -> tuple[tuple[float, float], float]:
+    """Centre and rim radius from the intensity step on the soil-facing rays ``angles``.
+
+    Coarse radius: :func:`_soil_onset`; then per ray the sub-pixel step near it and a
+    circle through those edges, 1.5 px outliers (rays through grousers, soil grains of
+    the wheel's grey) rejected; twice, each time about the new centre.
+    """
+    f = gray.astype(np.float32)
+    energy = cv2.blur((f - cv2.GaussianBlur(f, (0, 0), 1.0)) ** 2, (3, 3))
+    blur = cv2.GaussianBlur(f, (0, 0), 0.7)
+    center, r = (rough[0], rough[1]), rough[2]
+    for _ in range(2):
+        edge = _rim_edges(blur, center, angles, _soil_onset(energy, center, angles, r))
+        x, y = center[0] + np.cos(angles) * edge, center[1] + np.sin(angles) * edge
+        keep = np.ones(len(x), bool)
+        for _ in range(3):
+            cx, cy, rr = _kasa_circle(x[keep], y[keep])
+            keep = np.abs(np.hypot(x - cx, y - cy) - rr) < 1.5
+            if keep.sum() < 10:
+                raise WheelNotFoundError("the wheel's rim is not visible against the soil")
+        center, r = (cx, cy), rr
+    return center, r
+
+
+def _facing_soil(theta: np.ndarray, direction: int, soil_angles: np.ndarray | None) -> np.ndarray:
+    """Rays (model angle ``theta``) within 1 degree of a soil-facing image angle."""
+    if soil_angles is None or not len(soil_angles):
+        return np.ones(len(theta), bool)
+    bins = 360
+    hist = np.zeros(bins, bool)
+    hist[np.floor((soil_angles % (2 * np.pi)) / (2 * np.pi) * bins).astype(int) % bins] = True
+    hist = hist | np.roll(hist, 1) | np.roll(hist, -1)
+    image_angle = np.arctan2(np.cos(theta), direction * np.sin(theta)) % (2 * np.pi)
+    return hist[np.floor(image_angle / (2 * np.pi) * bins).astype(int) % bins]
 
 
 def _grousers(gray: np.ndarray, center: tuple[float, float], rim_px: float,
               direction: int, count: int | None,
-              height_px: float | None = None) -> tuple[int, float, float]:
+              height_px: float | None = None,
+              soil_angles: np.ndarray | None = None) -> tuple[int, float, float]:
     """Grouser count, angle and height from rays just outside the rim.
 
     A grouser is uniform along the ray where the soil is not: the spread of the
     intensity over ``rim + 1.5 .. rim + 4.5`` px (up to the grouser tip when its
     height is known), as a function of ``theta``, dips at
     each grouser; its harmonic at the grouser count (``swt.wheel``, else the strongest
-    harmonic when it is four times the median one) gives the phase. The height is the
+    harmonic when it is four times the median one) gives the phase; only the rays facing
+    soil count (above the soil surface a smooth background would dip too). The height is the
     median, over the grousers, of the run from the rim over which the intensity
     stays within 12 grey levels of the grouser's.
     """
@@ -134,7 +256,8 @@ def _grousers(gray: np.ndarray, center: tuple[float, float], rim_px: float,
     theta, values = _ray_samples(gray, center, radii, direction)
     depth = 7 if height_px is None else int(np.clip(2 * (height_px - 2.5), 7, values.shape[1]))
     spread = values[:, :depth].std(axis=1)
-    dip = np.median(spread) - spread
+    facing = _facing_soil(theta, direction, soil_angles)
+    dip = np.where(facing, np.median(spread[facing]) - spread, 0.0)
     spectrum = np.fft.rfft(dip)
     harmonics = np.arange(len(spectrum))
     band = (harmonics >= 3) & (harmonics <= 80)
@@ -156,29 +279,23 @@ def _grousers(gray: np.ndarray, center: tuple[float, float], rim_px: float,
 
 
 def detect_wheel(gray: np.ndarray, direction: int = 1, grouser_count: int | None = None,
-                 radius_px: float | None = None,
-                 grouser_height_px: float | None = None) -> WheelPose:
-    """Find the wheel in one grey frame (``direction``: +1 travel to the image right)."""
-    mask = smooth_region(gray)
-    ys, xs = np.nonzero(mask)
-    center = (float(xs.mean()), float(ys.mean()))
-    r_max = float(np.hypot(*gray.shape))
-    for _ in range(2):
-        theta, r_edge = _edge_radii(mask, center, r_max, direction)
-        ok = np.isfinite(r_edge)
-        if ok.sum() < N_RAYS // 4:
-            raise WheelNotFoundError("the wheel's edge is not visible")
-        rim = np.nanmedian(r_edge)
-        near = ok & (np.abs(r_edge - rim) < 2.5)
-        px = center[0] + direction * np.sin(theta[near]) * r_edge[near]
-        py = center[1] + np.cos(theta[near]) * r_edge[near]
-        cx, cy, _ = _kasa_circle(px, py)
-        center = (cx, cy)
-    theta, r_edge = _edge_radii(mask, center, r_max, direction)
-    rim = radius_px or _refine_rim(gray, center, float(np.nanmedian(r_edge)), direction)
+                 radius_px: float | None = None, grouser_height_px: float | None = None,
+                 prior: WheelPose | None = None) -> WheelPose:
+    """Find the wheel in one grey frame (``direction``: +1 travel to the image right).
+
+    ``prior`` (the previous frame's pose) replaces the RANSAC search: the rim is refit
+    on the rays that faced the soil there.
+    """
+    if prior is None:
+        cx, cy, r, pts = rough_circle(gray)
+        angles = np.arctan2(pts[:, 1] - cy, pts[:, 0] - cx)
+    else:
+        (cx, cy), r, angles = prior.center_px, prior.radius_px, prior.soil_angles_rad
+    center, rim = _fit_rim(gray, (cx, cy, r), np.sort(angles))
+    rim = radius_px or rim
     count, angle, height = _grousers(gray, center, rim, direction, grouser_count,
-                                     grouser_height_px)
-    return WheelPose(center, rim, height, count, angle)
+                                     grouser_height_px, angles)
+    return WheelPose(center, rim, height, count, angle, np.sort(angles))
 
 
 def track_wheel(frames: list[np.ndarray], direction: int = 1,
@@ -196,7 +313,7 @@ def track_wheel(frames: list[np.ndarray], direction: int = 1,
     for gray in frames:
         try:
             poses.append(detect_wheel(gray, direction, grouser_count, radius_px,
-                                      grouser_height_px))
+                                      grouser_height_px, poses[-1] if poses else None))
         except WheelNotFoundError:
             if center_px is None or radius_px is None:
                 raise

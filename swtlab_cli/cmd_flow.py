@@ -43,6 +43,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from softflow.field_analysis import analyse_frames
+    from softflow.flow_checks import FlowMeasurementError
     from softflow.frames import FrameSourceError, load_frames
     from softflow.wheel_detect import WheelNotFoundError
 
@@ -53,6 +54,9 @@ def run(args: argparse.Namespace) -> int:
                                 args.engine, frame_range=fs.frame_range, source=fs.source)
     except (FrameSourceError, WheelNotFoundError, OSError) as exc:
         print(f"swtlab flow: {exc}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    except FlowMeasurementError as exc:
+        print(f"swtlab flow: {fs.source}: soil flow not measured: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     data = result.to_dict()
     if args.json == "-":
@@ -77,6 +81,11 @@ def _summary(data: dict) -> None:
         fmt = lambda f: (f"{f['rate_per_m']:7.1f} [{f['ci95_per_m'][0]:6.1f},"  # noqa: E731
                          f"{f['ci95_per_m'][1]:6.1f}] R2 {f['r2']:.2f}") if f else "      -"
         print(f" {row['beta_deg']:7.1f}   {fmt(k):30s}  {fmt(a)}")
+    unfit = [f"{row['beta_deg']:.0f} deg {name}: {row[name + '_reason']}"
+             for row in data["per_beta"] for name in ("k", "alpha3")
+             if row.get(name + "_reason") and -160 < row["beta_deg"] < -20]
+    if unfit:
+        print("contact-region angles without a rate: " + "; ".join(unfit))
     g = data["grouser_model"]
     if g:
         scores = ", ".join(f"{m} {1000 * s:.3f}" for m, s in g["scores_mps"].items())
