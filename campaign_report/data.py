@@ -191,6 +191,11 @@ def _run_records(session: Session, results: pd.DataFrame) -> list[RunRecord]:
     return runs
 
 
+def _stored_float(value) -> float:
+    """A number of a stored fit's diagnostics (strict JSON keeps NaN as null: unknown)."""
+    return float("nan") if value is None else float(value)
+
+
 def _from_export(row, latest_ids: set[int], campaign_ids: set[int]
                  ) -> tuple[list[CurveFit], CurveSource] | None:
     """The export's fits of this campaign as ``fitting.CurveFit``; None if it has none."""
@@ -213,9 +218,8 @@ def _from_export(row, latest_ids: set[int], campaign_ids: set[int]
             slope_below_zero=d.get("slope_below_zero", 0.0),
             # the bands' inputs where the store keeps them (else unknown: no band)
             covariance=None if d.get("covariance") is None
-            else tuple(tuple(float(v) for v in row) for row in d["covariance"]),
-            scatter_sd=float(d.get("scatter_sd", float("nan"))),
-            k95=float(d.get("k95", float("nan")))))
+            else tuple(tuple(_stored_float(v) for v in row) for row in d["covariance"]),
+            scatter_sd=_stored_float(d.get("scatter_sd")), k95=_stored_float(d.get("k95"))))
     options = row.processing.parameters or {}
     stale = any(r.id not in latest_ids for f in mine for r in f.inputs)
     source = CurveSource(export_path=row.path, file_sha256=row.file_sha256,

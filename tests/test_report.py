@@ -317,5 +317,9 @@ def test_bands_on_the_interpolation_check_and_a_note_for_curves_without_them(sma
     assert "<th>inside the 95 % prediction band</th>" in section
     inside = re.findall(r"<td class=num>(\d+) of (\d+)</td>", section)
     assert inside and all(int(k) <= int(n) for k, n in inside)
-    # the small campaign's curves come from its export, stored without their covariance
-    assert "These curves carry no uncertainty" in page
+    # the small campaign's curves come from its export: the store keeps each fit's
+    # covariance, scatter and factor, so the exported curves have their bands
+    assert "These curves carry no uncertainty" not in page
+    widths = re.search(r"their largest half-widths: drawbar pull ± ([0-9.e-]+) / ± ([0-9.e-]+) N",
+                       page)
+    assert widths and 0 < float(widths.group(1)) < float(widths.group(2))

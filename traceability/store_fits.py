@@ -62,7 +62,8 @@ def store_fits(session: Session, table: pd.DataFrame, fits: list[Any],
                                                "oscillates", "max_departure",
                                                "step_below_zero", "slope_below_zero",
                                                "step_se", "slope_se", "branch_choice",
-                                               "branch_scores")},
+                                               "branch_scores", "covariance", "scatter_sd",
+                                               "k95") if k in d},
                 processing=record,
                 inputs=list(session.scalars(select(RunResult).where(
                     RunResult.id.in_(result_ids)))))
