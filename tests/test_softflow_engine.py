@@ -90,3 +90,27 @@ def test_cli_engine_choices_match_the_engines():
     from softflow.flow_engine import ENGINES
     from swtlab_cli.cmd_flow import ENGINE_CHOICES
     assert ENGINE_CHOICES == ENGINES
+
+
+def test_a_process_that_measured_flow_can_fork_workers():
+    """``swtlab process --jobs`` forks; after a numba parallel kernel under GNU OpenMP the
+    fork aborts ("fork() called from a process already using GNU OpenMP"). softflow runs
+    its kernels on the fork-safe workqueue layer: a child forked after a kernel runs one."""
+    import subprocess
+    import sys
+
+    script = (
+        "import numpy as np, numba\n"
+        "from concurrent.futures import ProcessPoolExecutor\n"
+        "from softflow.flow_engine import normalise_frames\n"
+        "def run(_):\n"
+        "    f = np.random.default_rng(0).random((64, 64), dtype=np.float32)\n"
+        "    return float(normalise_frames((f,), np.ones((64, 64), np.float32))[0].sum())\n"
+        "run(0)\n"
+        "assert numba.threading_layer() == 'workqueue', numba.threading_layer()\n"
+        "with ProcessPoolExecutor(2) as pool:\n"
+        "    print(list(pool.map(run, range(2))) == [run(0)] * 2)\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-500:]
+    assert done.stdout.strip() == "True"
