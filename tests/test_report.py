@@ -131,7 +131,9 @@ def test_figures_label_every_axis_with_a_unit_and_share_load_colours(small):
     assert "stored trace" in figs["no_stable"].axes[0].get_legend_handles_labels()[1]
     assert "digs in" in figs["no_stable"].get_suptitle()
     legend = [t.get_text() for t in figs["curves"].legends[0].get_texts()]
-    assert legend == ["70 N", "120 N", "180 N", "flagged, not fitted"]
+    # the stored fits carry their covariance: the curves' bands are in the legend
+    assert legend == ["70 N", "120 N", "180 N", "95 % confidence band", "95 % prediction band",
+                      "flagged, not fitted"]
     colour_180 = palette.colour(180.0)
     curve_colours = {line.get_color() for line in figs["curves"].axes[0].lines
                      if len(line.get_xdata()) == figures.CURVE_POINTS}
