@@ -17,19 +17,24 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv")
 
 
+def read_run_json(path: Path) -> dict[str, dict]:
+    """The metadata records of a spec ``run.json`` (``{"run": {...}, "wheel": {...}}``)."""
+    try:
+        records = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise IngestError(path, None, f"cannot read: {exc.strerror}") from None
+    except (ValueError, RecursionError) as exc:
+        why = "nested too deeply" if isinstance(exc, RecursionError) else exc
+        raise IngestError(path, None, f"not valid JSON: {why}") from None
+    if not isinstance(records, dict) or not all(isinstance(v, dict) for v in records.values()):
+        raise IngestError(path, None, 'expected {"run": {...}, "wheel": {...}, ...}')
+    return records
+
+
 def read_csv_run(folder: Path, cmap: ChannelMap) -> RawRun:
     """Raw topics of a CSV run folder, the records of its ``run.json``, and its frames."""
     folder = Path(folder)
-    meta_path = folder / "run.json"
-    try:
-        records = json.loads(meta_path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise IngestError(meta_path, None, f"cannot read: {exc.strerror}") from None
-    except (ValueError, RecursionError) as exc:
-        why = "nested too deeply" if isinstance(exc, RecursionError) else exc
-        raise IngestError(meta_path, None, f"not valid JSON: {why}") from None
-    if not isinstance(records, dict) or not all(isinstance(v, dict) for v in records.values()):
-        raise IngestError(meta_path, None, 'expected {"run": {...}, "wheel": {...}, ...}')
+    records = read_run_json(folder / "run.json")
     topics = {}
     for topic in cmap.topics:
         specs = cmap.channels_of(topic)

@@ -3,13 +3,13 @@ into a ``RawTopic``, and the sidecar ``<name>.run.json`` metadata records."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
 from ingest.channel_map import ChannelMap
+from ingest.csv_reader import read_run_json
 from ingest.errors import IngestError
 from ingest.raw import RawTopic
 
@@ -80,18 +80,7 @@ def sidecar_path(path: Path) -> Path:
 def sidecar_records(path: Path) -> dict[str, dict]:
     """Metadata records of the sidecar ``<name>.run.json`` (spec ``run.json`` layout), if any."""
     side = sidecar_path(path)
-    if not side.is_file():
-        return {}
-    try:
-        records = json.loads(side.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise IngestError(side, None, f"cannot read: {exc.strerror}") from None
-    except (ValueError, RecursionError) as exc:
-        why = "nested too deeply" if isinstance(exc, RecursionError) else exc
-        raise IngestError(side, None, f"not valid JSON: {why}") from None
-    if not isinstance(records, dict) or not all(isinstance(v, dict) for v in records.values()):
-        raise IngestError(side, None, 'expected {"run": {...}, "wheel": {...}, ...}')
-    return records
+    return read_run_json(side) if side.is_file() else {}
 
 
 def dotted_records(path: Path, items) -> dict[str, dict]:
