@@ -24,7 +24,12 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   the rests, ``sum(D^2 - se0^2 - se1^2) / sum(T)`` (:func:`pooled_diffusion`, one degree of
   freedom per run, GUM 4.2.4); a run alone has only its own ``D^2 / T``, one degree of freedom.
   Without two rests nothing is subtracted and the term is listed as not measured
-  (``swt.zero`` alone says nothing about the drift since the zeroing).
+  (``swt.zero`` alone says nothing about the drift since the zeroing). ``fz``'s zero is
+  ``swt.zero``'s, taken with the wheel lifted before the run: its drift from that zeroing to
+  the first rest is a random walk with the same diffusion over the zero's age, variance
+  ``sigma^2 (zero_age_s + t_rest)`` (``zero_age_s``: the lab's stated time from the zeroing
+  to a run's start, the longest where it varies, so the term is an upper bound for a pure
+  walk; not stated: listed as not measured). The other cells are re-zeroed at the rests.
 - ``calibration``: ``gain_rel_u`` times what the gain scales (the mean) and, where the
   zero is not re-measured (``fz``, or no rests), ``offset_u`` (the spec's optional
   ``swt.calibration`` keys; not stated: not measured).
@@ -78,14 +83,17 @@ INF = math.inf
 @dataclass(frozen=True)
 class BudgetParams:
     """What the budget is told about the rig: the loggers' clock tolerance (ppm, bound; None:
-    not stated, :data:`DEFAULT_CLOCK_PPM` is used and the budget says so)."""
+    not stated, :data:`DEFAULT_CLOCK_PPM` is used and the budget says so) and the age of the
+    load cells' zero at a run's start (s, the longest; None: not stated, module doc)."""
 
     clock_rate_bound_ppm: float | None = None
+    zero_age_s: float | None = None
 
     def __post_init__(self) -> None:
-        ppm = self.clock_rate_bound_ppm
-        if ppm is not None and not (math.isfinite(ppm) and ppm >= 0):
-            raise ValueError(f"clock_rate_bound_ppm {ppm} must be >= 0")
+        for name in ("clock_rate_bound_ppm", "zero_age_s"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} {value} must be >= 0")
 
     @property
     def clock_ppm(self) -> float:
@@ -98,7 +106,7 @@ class BudgetParams:
             "ppm assumed)",)
 
     def to_dict(self) -> dict:
-        return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm}
+        return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm, "zero_age_s": self.zero_age_s}
 
 
 @dataclass(frozen=True)
@@ -114,7 +122,9 @@ class Term:
 class DriftPart:
     """A load cell's share of a quantity's zero: ``weight`` (quantity per cell unit), the
     rests' means term (cell units), the time between the rests ``span_s``, the bridge factor
-    ``beta`` of the window and the run's own change ``change`` between the rests."""
+    ``beta`` of the window, the run's own change ``change`` between the rests and the time
+    ``age_s`` from the zeroing to the first rest over which the zero drifted unseen (0: the
+    cell is re-zeroed at the rests)."""
 
     column: str
     weight: float
@@ -122,14 +132,15 @@ class DriftPart:
     span_s: float
     beta: float
     change: float
+    age_s: float = 0.0
 
     def term(self, diffusion: dict[str, Term]) -> Term:
         """The zero-drift term, with the cell's pooled diffusion (per s) where given."""
         own = Term(self.change**2 / self.span_s, 1.0)
         sigma2 = diffusion.get(self.column, own)
-        bridge = Term(math.sqrt(self.beta * self.span_s * max(sigma2.u, 0.0)), sigma2.dof)
+        walk = (self.beta * self.span_s + self.age_s) * max(sigma2.u, 0.0)
         return _rss([Term(abs(self.weight) * self.means.u, self.means.dof),
-                     Term(abs(self.weight) * bridge.u, bridge.dof)])
+                     Term(abs(self.weight) * math.sqrt(walk), sigma2.dof)])
 
 
 @dataclass(frozen=True)
@@ -237,10 +248,11 @@ class ZeroAtWindow:
 
 
 def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[float, float],
-                   rest_value: float | None) -> ZeroAtWindow:
+                   rest_value: float | None, zero_age_s: float = 0.0) -> ZeroAtWindow:
     """The zero of ``column`` over the window: the rests' means less ``rest_value`` (what the
-    cell carries at rest; None: not known, only the change since the first rest is drift),
-    linear in time between the rests, with its uncertainty (module doc)."""
+    cell carries at rest; None: not known, only the change since the first rest is drift,
+    and the zero, ``zero_age_s`` old at the run's start, drifted unseen until the first
+    rest), linear in time between the rests, with its uncertainty (module doc)."""
     if rests is None or column not in rests.before or column not in rests.after:
         return ZeroAtWindow(0.0, None, "zero drift (no rest readings before and after the drive)")
     b, a = rests.before[column], rests.after[column]
@@ -252,7 +264,8 @@ def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[floa
     means = _rss([Term((1 - w) * b.stats.se, max(b.stats.n_eff - 1, 1)),
                   Term(w * a.stats.se, max(a.stats.n_eff - 1, 1))])
     beta = bridge_factor((window_s[0] - b.t_s) / span, (window_s[1] - b.t_s) / span)
-    return ZeroAtWindow(zero, DriftPart(column, 1.0, means, span, beta, d1 - d0))
+    age = 0.0 if rest_value is not None else zero_age_s + max(b.t_s, 0.0)
+    return ZeroAtWindow(zero, DriftPart(column, 1.0, means, span, beta, d1 - d0, age))
 
 
 def pooled_diffusion(rest_records: list[dict]) -> dict[str, Term]:
@@ -301,13 +314,17 @@ def _statistical(s: QuantityStats) -> Term:
 
 
 def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
-                 frequency_hz: float | None) -> QuantityBudget:
+                 frequency_hz: float | None, params: BudgetParams) -> QuantityBudget:
     """Budget of a single-cell quantity (thrust: the torque cell over the radius)."""
     column, per_radius = CELL_OF[key]
     scale = run.metadata.wheel.radius_m if per_radius else 1.0
     absolute = column != "fz_n"  # fz at rest reads the actual load, which it measures
-    z = zero_at_window(rests, column, window_s, 0.0 if absolute else None)
+    z = zero_at_window(rests, column, window_s, 0.0 if absolute else None,
+                       params.zero_age_s or 0.0)
     missing = [] if z.missing is None else [z.missing]
+    if z.part is not None and not absolute and params.zero_age_s is None:
+        missing.append("fz zero drift since the zeroing (zero_age_s not stated in "
+                       "swtlab.toml [uncertainty])")
     terms = {"statistical": _statistical(s)}
     drift = () if z.part is None else (replace(z.part, weight=1.0 / scale),)
     mean = s.mean - z.zero / scale
@@ -368,7 +385,7 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
     budgets: dict[str, QuantityBudget] = {}
     for key, s in quantities.items():
         if key in CELL_OF:
-            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz)
+            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz, params)
     if "resistance_n" in quantities and "thrust_n" in budgets and "dp_n" in budgets:
         budgets["resistance_n"] = _sum_budget(quantities["resistance_n"],
                                               [(budgets["thrust_n"], 1.0),

@@ -179,3 +179,35 @@ def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
 
     assert rect_normal_quantile(1.0, 1e-14) == pytest.approx(0.95, rel=1e-9)
     assert rect_normal_quantile(1.0, 0.05) == pytest.approx(0.95, abs=0.02)
+
+
+def test_the_fz_zero_drifts_unseen_from_the_zeroing_to_the_first_rest():
+    """fz is zeroed (swt.zero) ``zero_age_s`` before the run and re-zeroed never: a random
+    walk of diffusion 0.002 N^2/s over those 120 s and the 1.35 s to the first rest's mean
+    time: 120 s of it add 0.002 * 120 = 0.24 N^2 to its zero's variance; the DP cell,
+    re-zeroed at the rests, has no unseen age."""
+    rng = np.random.default_rng(8)
+    t = np.arange(0.0, 50.0, 0.01)
+    moving = (t > 3.0) & (t < 47.0)
+    angle = np.floor(np.cumsum(np.where(moving, 0.08, 0.0)) * 0.01 / 1e-3) * 1e-3
+    dp = rng.normal(0, 0.05, t.size) + np.where(moving, 40.0, 0.0)
+    fz = 180.0 + rng.normal(0, 0.05, t.size)
+    rests = rest_readings(_run(t, angle, dp, fz, 180.0))
+    diffusion = {"fz_n": Term(0.002, 50.0), "dp_n": Term(0.002, 50.0)}
+    fresh, aged = (zero_at_window(rests, "fz_n", (20.0, 40.0), None, age).part
+                   for age in (0.0, 120.0))
+    assert (fresh.age_s, aged.age_s) == (pytest.approx(1.35, abs=0.05),
+                                         pytest.approx(121.35, abs=0.05))
+    assert aged.term(diffusion).u ** 2 - fresh.term(diffusion).u ** 2 == pytest.approx(0.24)
+    dp_part = zero_at_window(rests, "dp_n", (20.0, 40.0), 0.0, 120.0).part
+    assert dp_part.age_s == 0.0
+
+
+def test_the_zero_age_is_read_from_the_campaign_settings(tmp_path):
+    from run_results.uncertainty_budget import BudgetParams
+    from swtlab.pipeline.process import budget_params
+
+    (tmp_path / "swtlab.toml").write_text("[uncertainty]\nzero_age_s = 180\n")
+    assert budget_params(tmp_path) == BudgetParams(None, 180.0)
+    with pytest.raises(ValueError, match="zero_age_s -5"):
+        BudgetParams(zero_age_s=-5.0)
