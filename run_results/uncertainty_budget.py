@@ -6,7 +6,7 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
 - ``statistical``: the window's autocorrelation-corrected SE (``run_results.stats``),
   ``nu = n_eff - 1`` (Type A, GUM 4.2). For the rates derived from encoder positions (slip,
   travel velocity, wheel speed) the batch-means SE with its lag-1 autocovariance
-  (``run_results.stats.batch_means_se``, ``B - 2`` degrees of freedom) instead: the
+  (``run_results.stats.batch_means_se``, Satterthwaite degrees of freedom) instead: the
   derivative filter's noise is anti-correlated at short lags, so the autocorrelation sum,
   which stops at the first negative pair, counts that noise in full and still ends before
   a slow ripple of the drives is seen.
