@@ -86,7 +86,7 @@ def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, flo
     (Gaussian), three times a plain sum of squares', so its degrees of freedom are
     Satterthwaite's ``2 E^2 / Var = (B-1)(B-2)^2 / (3 B^2)`` (Satterthwaite 1946, Biometrics
     Bull. 2(6) 110; about 5 for 20 batches), not ``B - 2``. None with fewer than 4 finite
-    samples per batch or a negative estimate."""
+    samples per batch; se 0 where the estimate is not positive (nothing resolved)."""
     y = np.asarray(y, float)
     if periodic is not None:
         y = y - np.nan_to_num(np.asarray(periodic, float))
@@ -98,4 +98,4 @@ def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, flo
     d = means - means.mean()
     var = (float(d @ d) + 2.0 * float(d[1:] @ d[:-1])) / ((batches - 1) * (batches - 2))
     dof = (batches - 1) * (batches - 2) ** 2 / (3.0 * batches**2)
-    return (float(np.sqrt(var)), dof) if var > 0 else None
+    return float(np.sqrt(max(var, 0.0))), dof

@@ -9,7 +9,11 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   (``run_results.stats.batch_means_se``, Satterthwaite degrees of freedom) instead: the
   derivative filter's noise is anti-correlated at short lags, so the autocorrelation sum,
   which stops at the first negative pair, counts that noise in full and still ends before
-  a slow ripple of the drives is seen.
+  a slow ripple of the drives is seen. With grousers every quantity's too, on the residual
+  about the phase-averaged wave: a real grouser wave wanders in phase (passage by passage)
+  and keeps ringing in that residual; summed, its autocorrelation's first positive lobes
+  count a wave that averages to zero over each pitch as noise, while batch means see only
+  what is left of it at zero frequency.
 - ``zero_drift``: the load cells' zero at the window, from the rest readings
   (``run_results.rest_readings``). DP, torque and side force read zero at rest; the zero is
   taken as linear in time between the two rests and subtracted (the ``correction``, GUM
@@ -314,7 +318,8 @@ def _statistical(s: QuantityStats) -> Term:
 
 
 def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
-                 frequency_hz: float | None, params: BudgetParams) -> QuantityBudget:
+                 frequency_hz: float | None, params: BudgetParams,
+                 batch: tuple[float, float] | None) -> QuantityBudget:
     """Budget of a single-cell quantity (thrust: the torque cell over the radius)."""
     column, per_radius = CELL_OF[key]
     scale = run.metadata.wheel.radius_m if per_radius else 1.0
@@ -325,7 +330,7 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
     if z.part is not None and not absolute and params.zero_age_s is None:
         missing.append("fz zero drift since the zeroing (zero_age_s not stated in "
                        "swtlab.toml [uncertainty])")
-    terms = {"statistical": _statistical(s)}
+    terms = {"statistical": _batch_statistical(s, batch)}
     drift = () if z.part is None else (replace(z.part, weight=1.0 / scale),)
     mean = s.mean - z.zero / scale
     gain_u, offset_u = run.metadata.calibration_u.get(FIELD_OF[column], (None, None))
@@ -343,9 +348,10 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
     return QuantityBudget(s.unit, -z.zero / scale, terms, tuple(missing), drift)
 
 
-def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> QuantityBudget:
+def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]],
+                batch: tuple[float, float] | None) -> QuantityBudget:
     """Budget of ``sum(sign * part)`` with its own statistical term (cells independent)."""
-    terms = {"statistical": _statistical(s)}
+    terms = {"statistical": _batch_statistical(s, batch)}
     for name in ("calibration", "quantisation", "phase_sampling"):
         found = [Term(abs(sign) * b.terms[name].u, b.terms[name].dof) for b, sign in parts
                  if name in b.terms]
@@ -357,9 +363,20 @@ def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> 
                           missing, drift)
 
 
+def _batch_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
+    """The batch-means statistical term, the autocorrelation one where it has none or
+    resolved nothing."""
+    return _statistical(s) if batch is None or not batch[0] > 0 else Term(*batch)
+
+
 def _rate_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
-    """The batch-means statistical term, the autocorrelation one where it has none."""
-    return _statistical(s) if batch is None else Term(*batch)
+    """A rate's batch-means term, at least the noise of the positions at the window's two
+    ends, which every rate from positions keeps: its mean is ``(x_n - x_0) / T``, and with
+    position noise ``sigma`` the rate's samples spread by ``s = sqrt(2) sigma / dt``, so
+    ``sqrt(2) sigma / T = s / n`` (where the batches resolve nothing, this is what is left)."""
+    if batch is None:
+        return _statistical(s)
+    return Term(max(batch[0], s.std / s.n), batch[1])
 
 
 def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
@@ -377,7 +394,7 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
                frequency_hz: float | None = None) -> tuple[dict[str, QuantityStats],
                                                            dict[str, QuantityBudget]]:
     """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
-    re-zeroing correction added (module doc); ``batches``: the rates' batch-means
+    re-zeroing correction added (module doc); ``batches``: the batch-means
     ``(se, dof)`` (``run_results.stats.batch_means_se``); ``frequency_hz``: the grouser
     passing frequency (None: no grousers)."""
     params = params or BudgetParams()
@@ -385,15 +402,17 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
     budgets: dict[str, QuantityBudget] = {}
     for key, s in quantities.items():
         if key in CELL_OF:
-            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz, params)
+            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz, params,
+                                        batches.get(key))
     if "resistance_n" in quantities and "thrust_n" in budgets and "dp_n" in budgets:
         budgets["resistance_n"] = _sum_budget(quantities["resistance_n"],
                                               [(budgets["thrust_n"], 1.0),
-                                               (budgets["dp_n"], -1.0)])
+                                               (budgets["dp_n"], -1.0)],
+                                              batches.get("resistance_n"))
     for key in ("hub_height_m", "sinkage_m"):
         if key in quantities:
             budgets[key] = _height_budget(run, key, quantities[key], window_s, budgets,
-                                          frequency_hz)
+                                          frequency_hz, batches.get(key))
     for key in SPEEDS:
         if key in quantities:
             budgets[key] = QuantityBudget(quantities[key].unit, 0.0,
@@ -415,10 +434,11 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
 
 
 def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict,
-                   frequency_hz: float | None) -> QuantityBudget:
+                   frequency_hz: float | None,
+                   batch: tuple[float, float] | None) -> QuantityBudget:
     """Hub height: statistics and the arm encoder's quantisation; sinkage of a flexible wheel
     also the wheel load's zero and calibration through ``fz / (1000 k)``."""
-    terms = {"statistical": _statistical(s)}
+    terms = {"statistical": _batch_statistical(s, batch)}
     hub = hub_samples(run, *window_s)
     if hub is not None:
         terms["quantisation"] = Term(_quantisation(resolution(hub[1]), s.std))

@@ -95,7 +95,7 @@ def test_batch_means_see_a_slow_ripple_and_ignore_telescoping_noise():
     # a rate from positions with white 1 mm noise: its mean telescopes to (x_end - x_0)/T,
     # sd sqrt(2) 1 mm / T = 3.5e-5 m/s; plain batch means say sqrt(B) = 4.5 times that
     # (measured 1.65e-4), the lag-1 term brings it to about twice (measured 7e-5; 40 % of
-    # the estimates negative: None, the autocorrelation SE is used then)
+    # the estimates not positive: se 0, the budget keeps the ends' noise then)
     rates = [np.diff(0.01 * np.arange(n) * dt + 1e-3 * rng.normal(size=n)) / dt
              for _ in range(100)]
     plain = [np.std(r[:1980].reshape(20, 99).mean(axis=1), ddof=1) / math.sqrt(20)
