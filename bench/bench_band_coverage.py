@@ -27,6 +27,7 @@ import swtlab  # noqa: E402
 from fitting import band, curves_by_load, fit_results, from_run_results  # noqa: E402
 from fitting import interpolate_load  # noqa: E402
 from terramechanics.testbed_law import ModelLaw  # noqa: E402
+from validation.coverage import wilson  # noqa: E402
 from test_fitting_synthetic import MODEL  # noqa: E402
 from virtual_testbed import RunCondition, generate_campaign  # noqa: E402
 from virtual_testbed.sample_campaign import SAMPLE_RATES  # noqa: E402
@@ -37,15 +38,6 @@ SLIPS = (-0.10, -0.05, 0.0, 0.05, 0.10, 0.20, 0.35, 0.60)
 HELD_OUT_SLIPS = (-0.08, -0.03, 0.03, 0.08, 0.15, 0.25, 0.40, 0.50)
 QUANTITIES = ("dp_n", "torque_nm", "sinkage_m", "resistance_n")
 VARIANTS = ("with_term", "without_term")
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """Wilson score interval of a binomial proportion (Wilson 1927, JASA 22, 209)."""
-    if n == 0:
-        return float("nan"), float("nan")
-    p, d = k / n, 1 + z * z / n
-    centre, half = (p + z * z / (2 * n)) / d, z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return float(centre - half), float(centre + half)
 
 
 def _campaign(seed: int):

@@ -116,11 +116,24 @@ def score(results: pd.DataFrame, truths: dict[str, dict]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion ``k/n`` (Wilson 1927, JASA 22, 209)."""
+    if n == 0:
+        return float("nan"), float("nan")
+    p, d = k / n, 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / d
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return float(centre - half), float(centre + half)
+
+
 def coverage(scores: pd.DataFrame) -> pd.DataFrame:
-    """Per quantity: runs, coverage of ``mean +- u95``, spread (std) and median of ``z``,
-    median coverage factor ``k``."""
+    """Per quantity: runs, coverage of ``mean +- u95`` with its Wilson 95 % interval
+    (``coverage_lo``, ``coverage_hi``), spread (std) and median of ``z``, median coverage
+    factor ``k``."""
     def summary(g: pd.DataFrame) -> pd.Series:
+        lo, hi = wilson(int(g["covered"].sum()), len(g))
         return pd.Series({"runs": len(g), "coverage": g["covered"].mean(),
+                          "coverage_lo": lo, "coverage_hi": hi,
                           "z_std": g["z"].std(), "z_median": g["z"].median(),
                           "k_median": (g["u95"] / g["u"]).median()})
     table = scores.groupby("quantity")[["covered", "z", "u", "u95"]].apply(summary)
