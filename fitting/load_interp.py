@@ -14,6 +14,15 @@ Across load: ``"pchip"`` (monotone piecewise-cubic Hermite, Fritsch & Carlson 19
 or more tested loads, ``"linear"`` otherwise (``"auto"`` picks so). Outside the tested loads
 only with ``allow_extrapolation=True``, then linearly from the two nearest loads, with a
 :class:`LoadExtrapolationWarning`.
+
+The interpolated curve's covariance holds the tested curves' (propagated) and, with 3 or
+more tested loads, the error of interpolating across load: estimated by the difference
+``d(s)`` between the PCHIP and the linear interpolant at the load (the a-posteriori estimate
+of an embedded pair of interpolants of two orders, as in Fehlberg's step-size control:
+Hairer, Norsett & Wanner 1993, Solving ODEs I, sec. II.4), taken as the bound of a
+rectangular error fully correlated along slip: ``+ v v^T / 3`` with ``v`` the curve
+parameters of ``d``. Zero at the tested loads; with two tested loads there is no second
+interpolant and the band holds the tested curves' uncertainty only.
 """
 
 from __future__ import annotations
@@ -233,10 +242,10 @@ def interpolate_loads(curves: Mapping[float, PowerCurve], loads_n, *, method: st
     coefficients, below = branch_from_solution(values @ projection, lo, hi, degree)
     misfit = curve_value(coefficients[:, None, :], grid, below[:, :1], below[:, 1:]) - values
     known = uncertainty and all(c.covariance is not None for c in ordered)
-    covariance = _propagate(ordered, tested, query, method, outside, grid,
-                            projection @ solution_to_parameters(lo, hi, degree,
-                                                                projection.shape[1])) \
-        if known else None
+    to_theta = projection @ solution_to_parameters(lo, hi, degree, projection.shape[1])
+    covariance = (_propagate(ordered, tested, query, method, outside, grid, to_theta)
+                  + _interpolation_error(tested, setup.values, query, outside, to_theta)
+                  if known else None)
     return LoadCurves(loads_n=query, coefficients=coefficients, below_zero=below,
                       slip_min=lo, slip_max=hi,
                       method=method, tested_loads_n=tuple(tested.tolist()), extrapolated=outside,
@@ -251,6 +260,19 @@ def _linear_in_load(ordered: list[PowerCurve], tested: np.ndarray, query: np.nda
     both = np.array([[c.scatter_sd, c.k95] for c in ordered])
     out = _across_load(tested, both, query, "linear", outside)
     return {"scatter_sd": np.maximum(out[:, 0], 0.0), "k95": np.maximum(out[:, 1], 0.0)}
+
+
+def _interpolation_error(tested: np.ndarray, values: np.ndarray, query: np.ndarray,
+                         outside: np.ndarray, to_theta: np.ndarray) -> np.ndarray | float:
+    """Covariance (queries x p x p) of the across-load interpolation error (module doc):
+    ``v v^T / 3``, ``v`` the parameters of PCHIP less linear on the grid; 0 with fewer than
+    three tested loads or outside them (extrapolation is linear: no second estimate)."""
+    if tested.size < 3:
+        return 0.0
+    difference = (_across_load(tested, values, query, "pchip", outside)
+                  - _across_load(tested, values, query, "linear", outside))
+    v = difference @ to_theta  # queries x p
+    return np.einsum("qa,qb->qab", v, v) / 3.0
 
 
 def _propagate(ordered: list[PowerCurve], tested: np.ndarray, query: np.ndarray, method: str,

@@ -178,7 +178,7 @@ def process_run(run, params: StablePhaseParams | None = None,
                          dp_trace=trace, corrections=corrections, **common)
     lo, hi = int(np.searchsorted(t, window.start_s)), int(np.searchsorted(t, window.end_s)) + 1
     oscillation, frequency = _oscillation(run, t, lo, hi, series)
-    quantities = {}
+    quantities, batches = {}, {}
     for key, (y, unit) in series.items():
         average = None
         if frequency and np.isfinite(y[lo:hi]).sum() > 16:
@@ -186,13 +186,9 @@ def process_run(run, params: StablePhaseParams | None = None,
         stats = quantity_stats(y[lo:hi], unit, average)
         if stats is not None:
             quantities[key] = stats
-    rate_batches = {}
-    for key in RATES:
-        if key in quantities:
-            y = series[key][0][lo:hi]
-            periodic = (phase_average(t[lo:hi], y, frequency)["periodic"]
-                        if frequency and np.isfinite(y).sum() > 16 else None)
-            rate_batches[key] = batch_means_se(y, periodic)
+            if key in RATES or average is not None:
+                batches[key] = batch_means_se(y[lo:hi], None if average is None
+                                              else average["periodic"])
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     quantities.update({k: v for k, v in native.items() if k in quantities})
@@ -203,7 +199,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     rests = rest_readings(run)
     corrections["rest_readings"] = None if rests is None else rests.to_dict()
     quantities, budgets = run_budget(run, (window.start_s, window.end_s), quantities, rests,
-                                     budget, rate_batches, frequency)
+                                     budget, batches, frequency)
     flags = (*_flags(run, window, oscillation), *image_flags,
              *plausibility_flags(run, window, quantities, params or StablePhaseParams()))
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,

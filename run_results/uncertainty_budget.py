@@ -6,10 +6,14 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
 - ``statistical``: the window's autocorrelation-corrected SE (``run_results.stats``),
   ``nu = n_eff - 1`` (Type A, GUM 4.2). For the rates derived from encoder positions (slip,
   travel velocity, wheel speed) the batch-means SE with its lag-1 autocovariance
-  (``run_results.stats.batch_means_se``, ``B - 2`` degrees of freedom) instead: the
+  (``run_results.stats.batch_means_se``, Satterthwaite degrees of freedom) instead: the
   derivative filter's noise is anti-correlated at short lags, so the autocorrelation sum,
   which stops at the first negative pair, counts that noise in full and still ends before
-  a slow ripple of the drives is seen.
+  a slow ripple of the drives is seen. With grousers every quantity's too, on the residual
+  about the phase-averaged wave: a real grouser wave wanders in phase (passage by passage)
+  and keeps ringing in that residual; summed, its autocorrelation's first positive lobes
+  count a wave that averages to zero over each pitch as noise, while batch means see only
+  what is left of it at zero frequency.
 - ``zero_drift``: the load cells' zero at the window, from the rest readings
   (``run_results.rest_readings``). DP, torque and side force read zero at rest; the zero is
   taken as linear in time between the two rests and subtracted (the ``correction``, GUM
@@ -24,7 +28,12 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   the rests, ``sum(D^2 - se0^2 - se1^2) / sum(T)`` (:func:`pooled_diffusion`, one degree of
   freedom per run, GUM 4.2.4); a run alone has only its own ``D^2 / T``, one degree of freedom.
   Without two rests nothing is subtracted and the term is listed as not measured
-  (``swt.zero`` alone says nothing about the drift since the zeroing).
+  (``swt.zero`` alone says nothing about the drift since the zeroing). ``fz``'s zero is
+  ``swt.zero``'s, taken with the wheel lifted before the run: its drift from that zeroing to
+  the first rest is a random walk with the same diffusion over the zero's age, variance
+  ``sigma^2 (zero_age_s + t_rest)`` (``zero_age_s``: the lab's stated time from the zeroing
+  to a run's start, the longest where it varies, so the term is an upper bound for a pure
+  walk; not stated: listed as not measured). The other cells are re-zeroed at the rests.
 - ``calibration``: ``gain_rel_u`` times what the gain scales (the mean) and, where the
   zero is not re-measured (``fz``, or no rests), ``offset_u`` (the spec's optional
   ``swt.calibration`` keys; not stated: not measured).
@@ -78,14 +87,17 @@ INF = math.inf
 @dataclass(frozen=True)
 class BudgetParams:
     """What the budget is told about the rig: the loggers' clock tolerance (ppm, bound; None:
-    not stated, :data:`DEFAULT_CLOCK_PPM` is used and the budget says so)."""
+    not stated, :data:`DEFAULT_CLOCK_PPM` is used and the budget says so) and the age of the
+    load cells' zero at a run's start (s, the longest; None: not stated, module doc)."""
 
     clock_rate_bound_ppm: float | None = None
+    zero_age_s: float | None = None
 
     def __post_init__(self) -> None:
-        ppm = self.clock_rate_bound_ppm
-        if ppm is not None and not (math.isfinite(ppm) and ppm >= 0):
-            raise ValueError(f"clock_rate_bound_ppm {ppm} must be >= 0")
+        for name in ("clock_rate_bound_ppm", "zero_age_s"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} {value} must be >= 0")
 
     @property
     def clock_ppm(self) -> float:
@@ -98,7 +110,7 @@ class BudgetParams:
             "ppm assumed)",)
 
     def to_dict(self) -> dict:
-        return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm}
+        return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm, "zero_age_s": self.zero_age_s}
 
 
 @dataclass(frozen=True)
@@ -114,7 +126,9 @@ class Term:
 class DriftPart:
     """A load cell's share of a quantity's zero: ``weight`` (quantity per cell unit), the
     rests' means term (cell units), the time between the rests ``span_s``, the bridge factor
-    ``beta`` of the window and the run's own change ``change`` between the rests."""
+    ``beta`` of the window, the run's own change ``change`` between the rests and the time
+    ``age_s`` from the zeroing to the first rest over which the zero drifted unseen (0: the
+    cell is re-zeroed at the rests)."""
 
     column: str
     weight: float
@@ -122,14 +136,15 @@ class DriftPart:
     span_s: float
     beta: float
     change: float
+    age_s: float = 0.0
 
     def term(self, diffusion: dict[str, Term]) -> Term:
         """The zero-drift term, with the cell's pooled diffusion (per s) where given."""
         own = Term(self.change**2 / self.span_s, 1.0)
         sigma2 = diffusion.get(self.column, own)
-        bridge = Term(math.sqrt(self.beta * self.span_s * max(sigma2.u, 0.0)), sigma2.dof)
+        walk = (self.beta * self.span_s + self.age_s) * max(sigma2.u, 0.0)
         return _rss([Term(abs(self.weight) * self.means.u, self.means.dof),
-                     Term(abs(self.weight) * bridge.u, bridge.dof)])
+                     Term(abs(self.weight) * math.sqrt(walk), sigma2.dof)])
 
 
 @dataclass(frozen=True)
@@ -237,10 +252,11 @@ class ZeroAtWindow:
 
 
 def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[float, float],
-                   rest_value: float | None) -> ZeroAtWindow:
+                   rest_value: float | None, zero_age_s: float = 0.0) -> ZeroAtWindow:
     """The zero of ``column`` over the window: the rests' means less ``rest_value`` (what the
-    cell carries at rest; None: not known, only the change since the first rest is drift),
-    linear in time between the rests, with its uncertainty (module doc)."""
+    cell carries at rest; None: not known, only the change since the first rest is drift,
+    and the zero, ``zero_age_s`` old at the run's start, drifted unseen until the first
+    rest), linear in time between the rests, with its uncertainty (module doc)."""
     if rests is None or column not in rests.before or column not in rests.after:
         return ZeroAtWindow(0.0, None, "zero drift (no rest readings before and after the drive)")
     b, a = rests.before[column], rests.after[column]
@@ -252,7 +268,8 @@ def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[floa
     means = _rss([Term((1 - w) * b.stats.se, max(b.stats.n_eff - 1, 1)),
                   Term(w * a.stats.se, max(a.stats.n_eff - 1, 1))])
     beta = bridge_factor((window_s[0] - b.t_s) / span, (window_s[1] - b.t_s) / span)
-    return ZeroAtWindow(zero, DriftPart(column, 1.0, means, span, beta, d1 - d0))
+    age = 0.0 if rest_value is not None else zero_age_s + max(b.t_s, 0.0)
+    return ZeroAtWindow(zero, DriftPart(column, 1.0, means, span, beta, d1 - d0, age))
 
 
 def pooled_diffusion(rest_records: list[dict]) -> dict[str, Term]:
@@ -301,14 +318,19 @@ def _statistical(s: QuantityStats) -> Term:
 
 
 def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
-                 frequency_hz: float | None) -> QuantityBudget:
+                 frequency_hz: float | None, params: BudgetParams,
+                 batch: tuple[float, float] | None) -> QuantityBudget:
     """Budget of a single-cell quantity (thrust: the torque cell over the radius)."""
     column, per_radius = CELL_OF[key]
     scale = run.metadata.wheel.radius_m if per_radius else 1.0
     absolute = column != "fz_n"  # fz at rest reads the actual load, which it measures
-    z = zero_at_window(rests, column, window_s, 0.0 if absolute else None)
+    z = zero_at_window(rests, column, window_s, 0.0 if absolute else None,
+                       params.zero_age_s or 0.0)
     missing = [] if z.missing is None else [z.missing]
-    terms = {"statistical": _statistical(s)}
+    if z.part is not None and not absolute and params.zero_age_s is None:
+        missing.append("fz zero drift since the zeroing (zero_age_s not stated in "
+                       "swtlab.toml [uncertainty])")
+    terms = {"statistical": _batch_statistical(s, batch)}
     drift = () if z.part is None else (replace(z.part, weight=1.0 / scale),)
     mean = s.mean - z.zero / scale
     gain_u, offset_u = run.metadata.calibration_u.get(FIELD_OF[column], (None, None))
@@ -326,9 +348,10 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
     return QuantityBudget(s.unit, -z.zero / scale, terms, tuple(missing), drift)
 
 
-def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> QuantityBudget:
+def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]],
+                batch: tuple[float, float] | None) -> QuantityBudget:
     """Budget of ``sum(sign * part)`` with its own statistical term (cells independent)."""
-    terms = {"statistical": _statistical(s)}
+    terms = {"statistical": _batch_statistical(s, batch)}
     for name in ("calibration", "quantisation", "phase_sampling"):
         found = [Term(abs(sign) * b.terms[name].u, b.terms[name].dof) for b, sign in parts
                  if name in b.terms]
@@ -340,9 +363,20 @@ def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]]) -> 
                           missing, drift)
 
 
+def _batch_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
+    """The batch-means statistical term, the autocorrelation one where it has none or
+    resolved nothing."""
+    return _statistical(s) if batch is None or not batch[0] > 0 else Term(*batch)
+
+
 def _rate_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
-    """The batch-means statistical term, the autocorrelation one where it has none."""
-    return _statistical(s) if batch is None else Term(*batch)
+    """A rate's batch-means term, at least the noise of the positions at the window's two
+    ends, which every rate from positions keeps: its mean is ``(x_n - x_0) / T``, and with
+    position noise ``sigma`` the rate's samples spread by ``s = sqrt(2) sigma / dt``, so
+    ``sqrt(2) sigma / T = s / n`` (where the batches resolve nothing, this is what is left)."""
+    if batch is None:
+        return _statistical(s)
+    return Term(max(batch[0], s.std / s.n), batch[1])
 
 
 def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
@@ -360,7 +394,7 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
                frequency_hz: float | None = None) -> tuple[dict[str, QuantityStats],
                                                            dict[str, QuantityBudget]]:
     """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
-    re-zeroing correction added (module doc); ``batches``: the rates' batch-means
+    re-zeroing correction added (module doc); ``batches``: the batch-means
     ``(se, dof)`` (``run_results.stats.batch_means_se``); ``frequency_hz``: the grouser
     passing frequency (None: no grousers)."""
     params = params or BudgetParams()
@@ -368,15 +402,17 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
     budgets: dict[str, QuantityBudget] = {}
     for key, s in quantities.items():
         if key in CELL_OF:
-            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz)
+            budgets[key] = _cell_budget(run, rests, window_s, key, s, frequency_hz, params,
+                                        batches.get(key))
     if "resistance_n" in quantities and "thrust_n" in budgets and "dp_n" in budgets:
         budgets["resistance_n"] = _sum_budget(quantities["resistance_n"],
                                               [(budgets["thrust_n"], 1.0),
-                                               (budgets["dp_n"], -1.0)])
+                                               (budgets["dp_n"], -1.0)],
+                                              batches.get("resistance_n"))
     for key in ("hub_height_m", "sinkage_m"):
         if key in quantities:
             budgets[key] = _height_budget(run, key, quantities[key], window_s, budgets,
-                                          frequency_hz)
+                                          frequency_hz, batches.get(key))
     for key in SPEEDS:
         if key in quantities:
             budgets[key] = QuantityBudget(quantities[key].unit, 0.0,
@@ -398,10 +434,11 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
 
 
 def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict,
-                   frequency_hz: float | None) -> QuantityBudget:
+                   frequency_hz: float | None,
+                   batch: tuple[float, float] | None) -> QuantityBudget:
     """Hub height: statistics and the arm encoder's quantisation; sinkage of a flexible wheel
     also the wheel load's zero and calibration through ``fz / (1000 k)``."""
-    terms = {"statistical": _statistical(s)}
+    terms = {"statistical": _batch_statistical(s, batch)}
     hub = hub_samples(run, *window_s)
     if hub is not None:
         terms["quantisation"] = Term(_quantisation(resolution(hub[1]), s.std))

@@ -61,19 +61,22 @@ def _summary(fits_by_seed, truth, held_out) -> pd.DataFrame:
         "held_out_runs": len(r["pred"])} for q, r in rows.items()}).T
 
 
-def _check(table: pd.DataFrame, low_conf: float, low_pred: float) -> None:
+def _check(table: pd.DataFrame, low_conf: float, low_pred: float,
+           many_runs: bool = True) -> None:
     assert (table["conf"] >= low_conf).all(), table["conf"]
     assert (table["pred"] >= low_pred).all(), table["pred"]
-    assert table["conf"].mean() <= 0.99 and table["pred"].mean() <= 0.995  # not 3x too wide
-    # across load the band holds the tested curves' uncertainty, not the error of
-    # interpolating between three loads (docs/fitting.md, "Bands"): lower there
-    assert table["conf_120"].min() >= 0.4
+    assert table["conf"].mean() <= 0.99  # not 3x too wide
+    if many_runs:  # 14 runs all inside is 49 % likely at a true 95 %: no test of width
+        assert table["pred"].mean() <= 0.995
+    # across load the band also holds the interpolation's error (docs/fitting.md, "Bands")
+    assert table["conf_120"].min() >= low_conf
 
 
 def test_in_family_bands_cover_the_model_and_new_runs():
     """Measured (seeds 0-19): confidence at the tested loads DP 0.91, torque 0.88, sinkage
-    0.93, resistance 0.96; at 120 N 0.96 / 0.83 / 0.76 / 0.97; new runs inside the
-    prediction band 0.98 / 0.95 / 0.96 / 0.95 (600 each)."""
+    0.93, resistance 0.96; at 120 N 0.97 / 0.92 / 0.95 / 0.99 (0.96 / 0.83 / 0.76 / 0.97
+    without the interpolation-error term); new runs inside the prediction band 0.98 / 0.955 /
+    0.96 / 0.95 (600 each)."""
     fits, new = [], []
     for seed in range(20):
         fits.append(fit_results(model_results_table(seed=seed), quantities=QUANTITIES))
@@ -106,10 +109,10 @@ def virtual_campaigns(tmp_path_factory):
 
 def test_virtual_testbed_bands_cover_the_law_and_held_out_runs(virtual_campaigns):
     """Measured (seeds 21, 22, budget uncertainties of processed raw runs): confidence at the
-    tested loads DP 0.90, torque 0.87, sinkage 0.89, resistance 0.97; at 120 N 0.68 / 0.62 /
-    0.52 / 0.95; held-out runs inside the prediction band 0.93 / 0.93 / 0.79 / 1.0 (14
-    each). With seed 23 as well: 0.92 / 0.90 / 0.90 / 0.94, at 120 N 0.78 / 0.75 / 0.68 /
-    0.95, held out 0.95 / 0.95 / 0.86 / 1.0 (21)."""
+    tested loads DP 0.90, torque 0.87, sinkage 0.89, resistance 0.97; at 120 N 0.94 / 0.84 /
+    0.96 / 0.96 (0.68 / 0.62 / 0.52 / 0.95 without the interpolation-error term); held-out
+    runs inside the prediction band 1.0 for all four (14 each; 0.93 / 0.93 / 0.79 / 1.0
+    without). Fresh seeds 30-49 with 160 held-out 120 N runs: bench/bench_band_coverage.py."""
     from terramechanics.testbed_law import ModelLaw
 
     law = ModelLaw(MODEL)
@@ -120,7 +123,7 @@ def test_virtual_testbed_bands_cover_the_law_and_held_out_runs(virtual_campaigns
         new.append(from_run_results(results[held]))
     table = _summary(fits, lambda w, s: law.evaluate(w, s, 0), new)
     print(f"\nvirtual testbed, seeds 21, 22:\n{table.round(3).to_string()}")
-    _check(table, low_conf=0.75, low_pred=0.75)
+    _check(table, low_conf=0.75, low_pred=0.75, many_runs=False)
 
 
 def test_the_120n_check_counts_the_runs_inside_the_interpolated_band():

@@ -95,7 +95,7 @@ def test_batch_means_see_a_slow_ripple_and_ignore_telescoping_noise():
     # a rate from positions with white 1 mm noise: its mean telescopes to (x_end - x_0)/T,
     # sd sqrt(2) 1 mm / T = 3.5e-5 m/s; plain batch means say sqrt(B) = 4.5 times that
     # (measured 1.65e-4), the lag-1 term brings it to about twice (measured 7e-5; 40 % of
-    # the estimates negative: None, the autocorrelation SE is used then)
+    # the estimates not positive: se 0, the budget keeps the ends' noise then)
     rates = [np.diff(0.01 * np.arange(n) * dt + 1e-3 * rng.normal(size=n)) / dt
              for _ in range(100)]
     plain = [np.std(r[:1980].reshape(20, 99).mean(axis=1), ddof=1) / math.sqrt(20)
@@ -179,3 +179,58 @@ def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
 
     assert rect_normal_quantile(1.0, 1e-14) == pytest.approx(0.95, rel=1e-9)
     assert rect_normal_quantile(1.0, 0.05) == pytest.approx(0.95, abs=0.02)
+
+
+def test_the_fz_zero_drifts_unseen_from_the_zeroing_to_the_first_rest():
+    """fz is zeroed (swt.zero) ``zero_age_s`` before the run and re-zeroed never: a random
+    walk of diffusion 0.002 N^2/s over those 120 s and the 1.35 s to the first rest's mean
+    time: 120 s of it add 0.002 * 120 = 0.24 N^2 to its zero's variance; the DP cell,
+    re-zeroed at the rests, has no unseen age."""
+    rng = np.random.default_rng(8)
+    t = np.arange(0.0, 50.0, 0.01)
+    moving = (t > 3.0) & (t < 47.0)
+    angle = np.floor(np.cumsum(np.where(moving, 0.08, 0.0)) * 0.01 / 1e-3) * 1e-3
+    dp = rng.normal(0, 0.05, t.size) + np.where(moving, 40.0, 0.0)
+    fz = 180.0 + rng.normal(0, 0.05, t.size)
+    rests = rest_readings(_run(t, angle, dp, fz, 180.0))
+    diffusion = {"fz_n": Term(0.002, 50.0), "dp_n": Term(0.002, 50.0)}
+    fresh, aged = (zero_at_window(rests, "fz_n", (20.0, 40.0), None, age).part
+                   for age in (0.0, 120.0))
+    assert (fresh.age_s, aged.age_s) == (pytest.approx(1.35, abs=0.05),
+                                         pytest.approx(121.35, abs=0.05))
+    assert aged.term(diffusion).u ** 2 - fresh.term(diffusion).u ** 2 == pytest.approx(0.24)
+    dp_part = zero_at_window(rests, "dp_n", (20.0, 40.0), 0.0, 120.0).part
+    assert dp_part.age_s == 0.0
+
+
+def test_the_zero_age_is_read_from_the_campaign_settings(tmp_path):
+    from run_results.uncertainty_budget import BudgetParams
+    from swtlab.pipeline.process import budget_params
+
+    (tmp_path / "swtlab.toml").write_text("[uncertainty]\nzero_age_s = 180\n")
+    assert budget_params(tmp_path) == BudgetParams(None, 180.0)
+    with pytest.raises(ValueError, match="zero_age_s -5"):
+        BudgetParams(zero_age_s=-5.0)
+
+
+def test_batch_means_of_a_drive_ripple_cover_at_their_stated_degrees_of_freedom():
+    """An AR(1) drive ripple of correlation time 0.7 s sampled at 36 Hz over 30 s (43
+    correlation times: the second rig's drives): the window means are covered by
+    ``+- t(0.975, dof) se`` about 95 % of the time, dof Satterthwaite's (B-1)(B-2)^2/(3B^2)
+    = 5.13 for 20 batches (by hand); with B - 2 = 18 they were covered about 91 %. The
+    mean of ``se^2`` is the variance of the mean less about 7 % (exact expectation: the
+    ripple's correlation reaching past one batch of 1.5 s; measured 11 % here)."""
+    from scipy.signal import lfilter
+
+    rng = np.random.default_rng(12)
+    n, phi = 1080, math.exp(-1 / 36 / 0.7)
+    series = [lfilter([1.0], [1.0, -phi], np.r_[rng.normal(), rng.normal(
+        0, math.sqrt(1 - phi**2), n - 1)]) for _ in range(1500)]
+    found = [batch_means_se(y) for y in series]
+    assert all(f[1] == pytest.approx(19 * 18**2 / 1200) for f in found if f)
+    kept = [(y.mean(), f[0]) for y, f in zip(series, found) if f]
+    means, ses = np.array(kept).T
+    truth_var = np.var([y.mean() for y in series])
+    assert 0.8 * truth_var <= np.mean(ses**2) <= truth_var
+    k = stats.t.ppf(0.975, 19 * 18**2 / 1200)
+    assert 0.93 <= np.mean(np.abs(means) <= k * ses) <= 0.97

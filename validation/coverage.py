@@ -11,7 +11,9 @@ then each run's ``mean +- u95`` is checked against its truth:
   ``bb2_sand`` model, ``ModelTruth``).
 
 The campaign's ``swtlab.toml`` states the loggers' clock tolerance the way a lab states its
-logger's datasheet value: the generator's own bound (200 ppm virtual, 150 ppm second rig).
+logger's datasheet value, and the longest time from zeroing the load cells to a run's start
+the way a lab states its procedure: the generator's own bounds (200 ppm and 0 s virtual: its
+drift starts at the run's start; 150 ppm and 180 s second rig).
 """
 
 from __future__ import annotations
@@ -48,8 +50,9 @@ def _draws(n: int, seed: int, loads: tuple[float, float]):
         yield i, kind, load, mp, slip
 
 
-def _settings(folder: Path, clock_ppm: float) -> None:
-    (folder / "swtlab.toml").write_text(f"[uncertainty]\nclock_rate_bound_ppm = {clock_ppm}\n")
+def _settings(folder: Path, clock_ppm: float, zero_age_s: float) -> None:
+    (folder / "swtlab.toml").write_text(f"[uncertainty]\nclock_rate_bound_ppm = {clock_ppm}\n"
+                                        f"zero_age_s = {zero_age_s}\n")
 
 
 def write_virtual(out: Path, n: int, seed: int, duration_s: float = 60.0) -> dict[str, dict]:
@@ -60,7 +63,7 @@ def write_virtual(out: Path, n: int, seed: int, duration_s: float = 60.0) -> dic
                                   slip if kind == "speed_control" else None))
     generate_campaign(out, conds, seed=seed, rates=SAMPLE_RATES, form="csv",
                       duration_s=duration_s)
-    _settings(out / "campaign", VirtualSensors().clock_rate_error_ppm)
+    _settings(out / "campaign", VirtualSensors().clock_rate_error_ppm, 0.0)
     truths = {}
     for c in conds:
         t = json.loads((out / "truth" / f"{c.run_id}.json").read_text())
@@ -88,7 +91,7 @@ def write_second(out: Path, n: int, seed: int) -> dict[str, dict]:
              for i, kind, load, mp, slip in _draws(n, seed, (80.0, 300.0))]
     sensors = SensorModel(write_calibration_uncertainty=True)
     write_campaign(out, conds, ModelTruth(model), seed, form="csv", rig=Rig(sensors=sensors))
-    _settings(out / "campaign", sensors.clock_ppm_max)
+    _settings(out / "campaign", sensors.clock_ppm_max, max(sensors.zero_lead_s))
     return {c.run_id: json.loads((out / "truth" / f"{c.run_id}.json").read_text())["steady"]
             for c in conds}
 
@@ -113,11 +116,24 @@ def score(results: pd.DataFrame, truths: dict[str, dict]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion ``k/n`` (Wilson 1927, JASA 22, 209)."""
+    if n == 0:
+        return float("nan"), float("nan")
+    p, d = k / n, 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / d
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return float(centre - half), float(centre + half)
+
+
 def coverage(scores: pd.DataFrame) -> pd.DataFrame:
-    """Per quantity: runs, coverage of ``mean +- u95``, spread (std) and median of ``z``,
-    median coverage factor ``k``."""
+    """Per quantity: runs, coverage of ``mean +- u95`` with its Wilson 95 % interval
+    (``coverage_lo``, ``coverage_hi``), spread (std) and median of ``z``, median coverage
+    factor ``k``."""
     def summary(g: pd.DataFrame) -> pd.Series:
+        lo, hi = wilson(int(g["covered"].sum()), len(g))
         return pd.Series({"runs": len(g), "coverage": g["covered"].mean(),
+                          "coverage_lo": lo, "coverage_hi": hi,
                           "z_std": g["z"].std(), "z_median": g["z"].median(),
                           "k_median": (g["u95"] / g["u"]).median()})
     table = scores.groupby("quantity")[["covered", "z", "u", "u95"]].apply(summary)
