@@ -87,6 +87,8 @@ def _indices(keys: np.ndarray, palette: np.ndarray, colours: np.ndarray | None =
     than white, if known."""
     if colours is None:
         colours = np.unique(keys[keys != WHITE_KEY])
+    _INDEX[palette] = np.arange(palette.size)  # a palette colour is its own nearest
+    colours = colours[~np.isin(colours, palette, assume_unique=True)]
     p = _rgb(palette)
     p_sq = (p * p).sum(axis=1)
     for start in range(0, colours.size, _CHUNK):
