@@ -81,6 +81,8 @@ def grid_mask(t_s: np.ndarray, timing: StreamTiming, grid: np.ndarray) -> np.nda
     inside = (grid >= t_s[0] - tol) & (grid <= t_s[-1] + tol)
     if len(t_s) < 2:
         return inside & np.isclose(grid, t_s[0])
+    if (np.diff(t_s) <= timing.gap_threshold_s).all():
+        return inside  # no interval is a gap: no grid point needs its interval looked up
     idx = np.clip(np.searchsorted(t_s, grid, side="right") - 1, 0, len(t_s) - 2)
     return inside & ((t_s[idx + 1] - t_s[idx]) <= timing.gap_threshold_s)
 
