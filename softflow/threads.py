@@ -5,7 +5,7 @@ machine's CPUs; a process pinned later (``taskset``, ``os.sched_setaffinity``, a
 worker given fewer cores) would run more threads than it has cores, and a parallel loop is
 only as fast as its slowest thread (issue 19 item 6: on a busy 2-core machine, 2 threads
 took 2.4x the time of one). :func:`capped` runs a function with numba's and
-OpenCV's threads at most :func:`available_cores` (never more than the caller set), and
+OpenCV's threads at most ``swtlab.cores.available_cores()`` (never more than the caller set), and
 restores them after. The results do not depend on the thread count (every parallel loop
 writes its own rows).
 """
@@ -13,21 +13,15 @@ writes its own rows).
 from __future__ import annotations
 
 import functools
-import os
 
 import cv2
 import numba
 
-
-def available_cores() -> int:
-    """Cores this process may run on now (its CPU affinity; all CPUs where there is none)."""
-    if hasattr(os, "sched_getaffinity"):
-        return max(1, len(os.sched_getaffinity(0)))
-    return os.cpu_count() or 1
+from swtlab.cores import available_cores
 
 
 def capped(fn):
-    """``fn`` run with numba and OpenCV on at most :func:`available_cores` threads."""
+    """``fn`` run with numba and OpenCV on at most ``available_cores()`` threads."""
 
     @functools.wraps(fn)
     def run(*args, **kwargs):
