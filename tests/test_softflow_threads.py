@@ -17,6 +17,14 @@ pytestmark = pytest.mark.skipif(
     or numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 cores and a settable affinity")
 
 
+@pytest.fixture(autouse=True)
+def _threads_restored():
+    before = numba.get_num_threads(), cv2.getNumThreads()
+    yield
+    numba.set_num_threads(before[0])
+    cv2.setNumThreads(before[1])
+
+
 def test_threads_capped_to_the_affinity_and_restored():
     cores = os.sched_getaffinity(0)
     seen = {}
@@ -46,10 +54,7 @@ def test_displacement_independent_of_the_thread_count():
     numba.set_num_threads(2)
     two = pair_displacement_px(a, b)
     numba.set_num_threads(1)
-    try:
-        one = pair_displacement_px(a, b)
-    finally:
-        numba.set_num_threads(2)
+    one = pair_displacement_px(a, b)
     np.testing.assert_array_equal(one, two)
     # and it is the shift: content moved +0.9 px in x, +0.4 px in y
     inner = np.s_[24:-24, 24:-24]
