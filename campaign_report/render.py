@@ -8,11 +8,14 @@ from collections.abc import Callable, Iterable
 from datetime import UTC, datetime
 from pathlib import Path
 
+from matplotlib import rc_context
+
 from campaign_report import sections
 from campaign_report.replicates import replicates_section
 from campaign_report.data import CampaignData, campaign_names, gather
 from campaign_report.extensions import optional_sections
 from campaign_report.html import Page, render_page
+from campaign_report.images import RENDER_RC
 from campaign_report.style import Palette
 from swtlab.atomic import write_atomically
 from traceability import open_database
@@ -44,6 +47,11 @@ def page_paths(path: str | Path, names: list[str]) -> dict[str, Path]:
 
 def build_page(data: CampaignData, progress: Progress = _no_progress) -> Page:
     """Every section of one campaign's page, drawn from ``data`` alone."""
+    with rc_context(RENDER_RC):
+        return _build_page(data, progress)
+
+
+def _build_page(data: CampaignData, progress: Progress) -> Page:
     palette = Palette(data.loads, data.multipasses)
     images = [sections.timeseries_image(i, run, palette)
               for i, run in progress(list(enumerate(data.runs)), f"report {data.name}")]

@@ -101,12 +101,31 @@ def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
                               "every field of a block must have one value per t_ns")
         lengths[i] = sizes["t_ns"]
     total = int(lengths.sum())
-    t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64)  # checked before sorting
-    firsts = np.array([b["t_ns"][0] if b["t_ns"] else np.iinfo(np.int64).max for b in blocks])
-    blocks = [blocks[i] for i in np.argsort(firsts, kind="stable")]
-    t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64)
-    fields = {k: _flatten(path, topic, k, blocks, total, np.float64) for k in names if k != "t_ns"}
+    plain = all(map(_numbers_only, data, map(len, blocks)))
+    t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64, plain)
+    starts = np.concatenate([[0], np.cumsum(lengths)])
+    firsts = np.full(len(blocks), np.iinfo(np.int64).max)  # an empty block sorts last
+    firsts[lengths > 0] = t_ns[starts[:-1][lengths > 0]]
+    order = np.argsort(firsts, kind="stable")  # blocks by their first time stamp
+    if (order != np.arange(len(blocks))).any():
+        blocks = [blocks[i] for i in order]
+        t_ns = np.concatenate([t_ns[starts[i]:starts[i + 1]] for i in order])
+    fields = {k: _flatten(path, topic, k, blocks, total, np.float64, plain)
+              for k in names if k != "t_ns"}
     return RawTopic(t_s=t_ns * 1e-9, fields=fields)
+
+
+#: the bytes of JSON numbers and arrays of them (``e`` of ``true``/``false`` included)
+_NUMBER_BYTES = b"0123456789+-.eE,[] \t\r\n"
+
+
+def _numbers_only(message: bytes, keys: int) -> bool:
+    """Whether a block's JSON of ``keys`` fields can hold nothing but numbers and null: what
+    is left of it without the bytes of numbers (keys, punctuation, literals) has no string
+    other than its keys (two quotes per key) and no ``true``/``false`` (a key with ``tru``,
+    ``fals`` or an escaped quote merely sends the block through the checks sample by sample)."""
+    rest = message.translate(None, _NUMBER_BYTES)
+    return rest.count(b'"') == 2 * keys and b"tru" not in rest and b"fals" not in rest
 
 
 #: JSON types a sample may have: numbers, and null (how many writers spell NaN)
@@ -116,12 +135,42 @@ MAX_T_NS = 100 * 365 * 86400 * 10**9
 
 
 def _flatten(path: Path, topic: str, name: str, blocks: list[dict], total: int,
-             dtype: type) -> np.ndarray:
+             dtype: type, plain: bool = False) -> np.ndarray:
     """One field of every block as one array. A sample that is not a JSON number or null
     (true/false, a numeric string, a list) is an error, not converted; a time stamp must be a
-    whole number of ns in ``0..MAX_T_NS``; a number beyond float64 is an error."""
+    whole number of ns in ``0..MAX_T_NS``; a number beyond float64 is an error.
+
+    ``plain``: the blocks' JSON holds no string sample and no ``true``/``false``
+    (:func:`_numbers_only`), so the samples are numbers, null or lists: converted in one
+    pass, and anything that pass refuses (a list, a huge number, a time stamp that is not a
+    whole number) goes through the sample-by-sample checks of :func:`_checked`, which
+    convert the same numbers to the same values and name the problem."""
+    if plain and dtype is np.float64:
+        try:  # null -> NaN, as below; a list or a number beyond float64 raises
+            return np.fromiter(chain.from_iterable(b[name] for b in blocks), np.float64,
+                               count=total)
+        except (ValueError, TypeError, OverflowError):
+            pass
+    values = list(chain.from_iterable(b[name] for b in blocks))
+    if plain:  # time stamps: their sum stays an int only if every one is (no bool: plain)
+        try:
+            found = np.fromiter(values, np.int64, count=total) \
+                if type(sum(values)) is int else None
+        except (TypeError, OverflowError):  # a null or a list; beyond int64
+            found = None
+        if found is not None:
+            if found.size and not (0 <= found.min() and found.max() <= MAX_T_NS):
+                raise IngestError(path, f"{topic}.{name}", f"time stamps outside "
+                                  f"0..{MAX_T_NS} ns (t_ns counts ns from the run start)")
+            return found
+    return _checked(path, topic, name, values, total, dtype)
+
+
+def _checked(path: Path, topic: str, name: str, values: list, total: int,
+             dtype: type) -> np.ndarray:
+    """:func:`_flatten` sample by sample: each sample's JSON type checked."""
     where = f"{topic}.{name}"
-    kinds = set(map(type, chain.from_iterable(b[name] for b in blocks)))
+    kinds = set(map(type, values))
     if not kinds <= _SAMPLE_TYPES:
         bad = sorted(k.__name__ for k in kinds - _SAMPLE_TYPES)
         raise IngestError(path, where, f"samples of JSON type {', '.join(bad)}; every sample "
@@ -130,14 +179,12 @@ def _flatten(path: Path, topic: str, name: str, blocks: list[dict], total: int,
         if kinds - {int}:
             raise IngestError(path, where, "time stamps must be whole numbers of ns (no "
                               "decimals, no null)")
-        values = list(chain.from_iterable(b[name] for b in blocks))
         if values and not (0 <= min(values) and max(values) <= MAX_T_NS):
             raise IngestError(path, where, f"time stamps outside 0..{MAX_T_NS} ns (t_ns counts "
                               "ns from the run start)")
         return np.array(values, dtype=np.int64)
-    values = chain.from_iterable(b[name] for b in blocks)
     if type(None) in kinds:
-        values = (np.nan if v is None else v for v in values)
+        values = [np.nan if v is None else v for v in values]
     try:
         return np.fromiter(values, dtype=np.float64, count=total)
     except OverflowError:

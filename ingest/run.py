@@ -140,7 +140,7 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
             check_calibrated(raw.path, f"{topic}.{spec.field}", spec.column, values)
             columns[spec.column] = values
             units[spec.column] = spec.unit if cal is None else "SI (swt.calibration)"
-        streams[topic] = pd.DataFrame(columns)
+        streams[topic] = pd.DataFrame(columns, copy=False)  # its own arrays: no copy
     for topic, fld in sorted(set(metadata.calibration) - used):
         problems.append(Problem("warning", f"{topic}.{fld}",
                                 "swt.calibration names a channel this run does not have"))
@@ -205,7 +205,7 @@ def _channel_table(streams, timing, metadata: RunMetadata, provided: set[str],
         table.setdefault(column, np.full(len(grid), np.nan))
     order = ["t_s", *CANONICAL, *(c for c in DERIVED if c not in CANONICAL)]
     order += sorted(set(table) - set(order))  # extra columns a channel map adds
-    return pd.DataFrame({c: table[c] for c in order}), derivation
+    return pd.DataFrame({c: table[c] for c in order}, copy=False), derivation  # arrays made here
 
 
 def _derive_rates(table, streams, rate, metadata, provided, derivation) -> None:

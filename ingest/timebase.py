@@ -76,13 +76,22 @@ def common_grid(timings: list[StreamTiming]) -> tuple[np.ndarray, float]:
 
 
 def grid_mask(t_s: np.ndarray, timing: StreamTiming, grid: np.ndarray) -> np.ndarray:
-    """True where the grid lies inside the stream's span and not inside one of its gaps."""
+    """True where the grid (ascending) lies inside the stream's span and not inside one of its
+    gaps."""
     tol = 1e-6 * timing.median_dt_s if np.isfinite(timing.median_dt_s) else 1e-9
     inside = (grid >= t_s[0] - tol) & (grid <= t_s[-1] + tol)
     if len(t_s) < 2:
         return inside & np.isclose(grid, t_s[0])
-    idx = np.clip(np.searchsorted(t_s, grid, side="right") - 1, 0, len(t_s) - 2)
-    return inside & ((t_s[idx + 1] - t_s[idx]) <= timing.gap_threshold_s)
+    # a grid point belongs to the interval t_s[i] <= t < t_s[i + 1] (before the first time
+    # stamp: the first interval; from the last but one on: the last); the ascending grid
+    # points of a gap's interval are one slice of it
+    gaps = np.flatnonzero(~(np.diff(t_s) <= timing.gap_threshold_s))
+    last = len(t_s) - 2
+    for i in gaps:
+        lo = t_s[i] if i > 0 else -np.inf
+        hi = t_s[i + 1] if i < last else np.inf
+        inside[np.searchsorted(grid, lo):np.searchsorted(grid, hi)] = False
+    return inside
 
 
 def to_grid(t_s: np.ndarray, values: np.ndarray, grid: np.ndarray, mask: np.ndarray) -> np.ndarray:

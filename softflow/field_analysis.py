@@ -23,6 +23,7 @@ from softflow.flow_checks import check_contact_fits, check_sled_velocity, fit_re
 from softflow.flow_engine import MeanField, average_flow
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
+from softflow.threads import capped
 from softflow.volumetric_strain import strain_by_beta
 from softflow.wheel_detect import (MASK_MARGIN_PX, WheelPose, smooth_pixels, soil_mask,
                                    track_wheel)
@@ -104,6 +105,7 @@ def _rates(fits: list[DecayFit | None]) -> np.ndarray:
     return np.array([f.rate_per_m if f and f.r2 > 0.5 else np.nan for f in fits])
 
 
+@capped
 def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
                    direction: int = 1, wheel_center_px: tuple[float, float] | None = None,
                    wheel_radius_px: float | None = None, grouser_count: int | None = None,

@@ -62,6 +62,7 @@ import numba
 import numpy as np
 
 from softflow import bspline_warp
+from softflow.threads import capped
 
 ENGINES = ("deform-lk", "farneback", "dis")
 GRID_PX = 2  # the windows are solved on a grid this much coarser than the pixels
@@ -233,6 +234,7 @@ def _deform_lk(a: np.ndarray, b: np.ndarray, soil: np.ndarray,
     return _upsample(coarse, a.shape)
 
 
+@capped
 def pair_displacement_px(frame_a: np.ndarray, frame_b: np.ndarray, engine: str = "deform-lk",
                          soil: np.ndarray | None = None,
                          windows: tuple[int, ...] = ICI_KERNELS_PX) -> np.ndarray:

@@ -100,8 +100,9 @@ def _client(address: str):
 def run(args: argparse.Namespace) -> int:
     import ingest
     from swtlab.pipeline.database import store_one
-    from swtlab.pipeline.process import (ProcessSettings, available_cores, budget_params,
-                                         find_runs, process_files, rig_compliance)
+    from swtlab.cores import available_cores
+    from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
+                                         process_files, rig_compliance)
     from traceability import open_database
     from traceability.database import in_transaction
     from traceability.hashing import content_sha256

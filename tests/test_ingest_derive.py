@@ -118,3 +118,18 @@ def test_stream_timing_reports_gaps_and_jitter():
     rng = np.random.default_rng(1)
     jittery = np.cumsum(rng.uniform(0.001, 0.03, 500))
     assert stream_timing(jittery).jitter > 0.5
+
+
+def test_grid_mask_false_inside_gaps_including_the_first_and_last_interval():
+    # median interval 0.1 s: a gap is an interval over 0.5 s; a grid point t belongs to the
+    # interval t_s[i] <= t < t_s[i + 1] (hand-counted below)
+    grid = np.arange(14) / 10.0  # 0.0 ... 1.3 s
+    t_inner = np.array([0.0, 0.1, 0.2, 0.3, 0.9, 1.0, 1.1, 1.2, 1.3])  # gap 0.3 -> 0.9
+    inner = grid_mask(t_inner, stream_timing(t_inner), grid)
+    assert inner.tolist() == [True] * 3 + [False] * 6 + [True] * 5
+    t_first = np.array([0.0, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3])  # gap 0.0 -> 0.8
+    first = grid_mask(t_first, stream_timing(t_first), grid)
+    assert first.tolist() == [False] * 8 + [True] * 6
+    t_last = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 1.3])  # gap 0.4 -> 1.3, the last interval
+    last = grid_mask(t_last, stream_timing(t_last), grid)
+    assert last.tolist() == [True] * 4 + [False] * 10

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 from datetime import datetime, timezone
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -218,3 +219,17 @@ def test_irregular_clock_is_reported(tmp_path, ingest_tools, ingest_spec):
     irregular = [p for p in run.problems if "irregular clock" in p.message]
     assert [p.channel for p in irregular] == ["/suspension/angle"]
     assert run.timing["/suspension/angle"].jitter > 0.5
+
+
+def test_blocks_decode_the_same_on_the_one_pass_and_the_checked_path():
+    """Numbers, a null and out-of-order blocks; a key holding "true" sends the same blocks
+    through the sample-by-sample checks: both give the hand-written arrays."""
+    from ingest.mcap_reader import _decode_blocks
+
+    blocks = [b'{"t_ns": [20], "fz": [2]}', b'{"t_ns": [0, 10], "fz": [1.5, null]}']
+    for key, data in (("fz", blocks), ("true_fz", [b.replace(b'"fz"', b'"true_fz"')
+                                                   for b in blocks])):
+        topic = _decode_blocks(Path("run.mcap"), "/hub/wrench", data)
+        np.testing.assert_array_equal(topic.t_s, np.array([0, 10, 20]) * 1e-9)  # t_ns 1e-9
+        np.testing.assert_array_equal(topic.fields[key], [1.5, np.nan, 2.0])
+        assert topic.fields[key].dtype == np.float64

@@ -6,7 +6,6 @@ one writer (docs/scale-out.md)."""
 from __future__ import annotations
 
 import dataclasses
-import os
 import tomllib
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
@@ -145,11 +144,6 @@ def _process(path: Path, settings: ProcessSettings, content: tuple[str, int] | N
         done.run = dataclasses.replace(done.run, streams={}, channels=done.run.channels.iloc[:0],
                                        frames={})
     return done
-
-
-def available_cores() -> int:
-    """The cores this process may run on (its CPU affinity), the default number of jobs."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
 
 
 def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *,

@@ -1,0 +1,43 @@
+"""Threads of the soil-flow kernels capped to the cores this process may run on.
+
+numba sizes its thread pool once, from the CPU affinity at import, and OpenCV from the
+machine's CPUs; a process pinned later (``taskset``, ``os.sched_setaffinity``, a cluster
+worker given fewer cores) would run more threads than it has cores, and a parallel loop is
+only as fast as its slowest thread (issue 19 item 6: on a busy 2-core machine, 2 threads
+took 2.4x the time of one). :func:`capped` runs a function with numba's and
+OpenCV's threads at most ``swtlab.cores.available_cores()`` (never more than the caller set), and
+restores them after. The results do not depend on the thread count (every parallel loop
+writes its own rows).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import cv2
+import numba
+
+from swtlab.cores import available_cores
+
+
+def capped(fn):
+    """``fn`` run with numba and OpenCV on at most ``available_cores()`` threads."""
+
+    @functools.wraps(fn)
+    def run(*args, **kwargs):
+        cores = available_cores()
+        numba_before, cv_before = numba.get_num_threads(), cv2.getNumThreads()
+        numba_n, cv_n = min(numba_before, cores), min(max(cv_before, 1), cores)
+        if numba_n != numba_before:
+            numba.set_num_threads(numba_n)
+        if cv_n != cv_before:
+            cv2.setNumThreads(cv_n)
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            if numba_n != numba_before:
+                numba.set_num_threads(numba_before)
+            if cv_n != cv_before:
+                cv2.setNumThreads(cv_before)
+
+    return run
