@@ -9,22 +9,30 @@ from dataclasses import replace
 import numpy as np
 
 from softflow.track_slip import NoPeriodicMarksError, measure_track_slip
-from virtual_testbed.second_track_render import (SecondTrackScene, random_second_track,
-                                                 render_second_track)
+from virtual_testbed.second_track_render import random_second_track, render_second_track
 from virtual_testbed.track_render import mark_spacing_m, random_nuisance, render_track
 
 RADIUS_M, GROUSERS, HEIGHT_M = 0.125, 12, 0.0092  # BB2-like wheel
 SIZE_PX = (800, 600)
 
 
-def _accuracy(count: int) -> dict:
+#: seeds looked at while tuning the period and mark fits (issue 21): first renderer 50 000-50 199
+#: with 60 000 on (this bench's old draw), second renderer 80 000-80 039, 200-229, 300, 700-703;
+#: the figures come from the fresh draws below
+FRESH_FIRST, FRESH_SECOND = 150_000, 1000
+
+
+def _accuracy(count: int, base: int = FRESH_FIRST) -> dict:
+    """First renderer: slip evenly over 0-0.8, scale ``rng(base + i)``, nuisances ``base + 10 000
+    + i``, render seed ``base + i``."""
     errors_pp, refused, seconds = [], 0, []
     slips = np.linspace(0.0, 0.8, count)
     for i, slip in enumerate(slips):
-        rng = np.random.default_rng(50_000 + i)
+        rng = np.random.default_rng(base + i)
         px_per_m = float(rng.uniform(600, 900))
-        image, truth = render_track(float(slip), RADIUS_M, GROUSERS, HEIGHT_M, px_per_m, seed=i,
-                                    nuisance=random_nuisance(60_000 + i, SIZE_PX))
+        image, truth = render_track(float(slip), RADIUS_M, GROUSERS, HEIGHT_M, px_per_m,
+                                    seed=base + i,
+                                    nuisance=random_nuisance(base + 10_000 + i, SIZE_PX))
         start = time.perf_counter()
         try:
             result = measure_track_slip(image, RADIUS_M, GROUSERS, px_per_m=px_per_m)
@@ -96,16 +104,16 @@ def _baseline_s() -> float:
     return time.perf_counter() - start
 
 
-def _second(count: int) -> dict:
+def _second(count: int, base: int = FRESH_SECOND) -> dict:
     """Second renderer (written apart): jittered, erased and smeared marks, uneven light,
-    rotation, keystone, JPEG q80; seeds 80 000 on, slip evenly over 0-0.8; mark-free photos;
+    rotation, keystone, JPEG q80; seeds ``base`` on, slip evenly over 0-0.8; mark-free photos;
     seconds per photo with OpenCV on one thread."""
     import cv2
 
     cv2.setNumThreads(1)
     errors_pp, seconds = [], []
     for i, slip in enumerate(np.linspace(0.0, 0.8, count)):
-        scene = random_second_track(80_000 + i, float(slip))
+        scene = random_second_track(base + i, float(slip))
         image, truth = render_second_track(scene)
         start = time.perf_counter()
         try:
@@ -114,29 +122,32 @@ def _second(count: int) -> dict:
         except NoPeriodicMarksError:
             errors_pp.append(np.inf)
         seconds.append(time.perf_counter() - start)
-    refused = 0
-    for i in range(max(count // 10, 3)):
-        image, _ = render_second_track(SecondTrackScene(marks=False, seed=90_000 + i))
+    refused, mark_free = 0, max(count // 4, 5)
+    for i in range(mark_free):  # random rotation, light, keystone; no marks
+        image, _ = render_second_track(replace(random_second_track(90_000 + i, 0.3), marks=False))
         try:
             measure_track_slip(image, 0.125, 12, px_per_m=700.0)
         except NoPeriodicMarksError:
             refused += 1
     err = np.array(errors_pp)
-    base = _baseline_s()
+    baseline_s = _baseline_s()
     out = {"renders": count, "refused": int(np.sum(~np.isfinite(err))),
            "within_0p5pp": float(np.mean(err <= 0.5)),
            "median_abs_error_pp": float(np.median(err)),
            "p95_abs_error_pp": float(np.percentile(err, 95)),
-           "mark_free": max(count // 10, 3), "mark_free_refused": refused,
+           "mark_free": mark_free, "mark_free_refused": refused,
            "median_seconds_one_thread": float(np.median(seconds)),
-           "baseline_seconds": base, "photo_over_baseline": float(np.median(seconds) / base)}
+           "baseline_seconds": baseline_s,
+           "photo_over_baseline": float(np.median(seconds) / baseline_s)}
     print("second renderer:", {k: round(v, 4) if isinstance(v, float) else v
                                for k, v in out.items()})
+    print(f"seconds per photo (one thread, median): {out['median_seconds_one_thread']:.2f}; "
+          f"fixed workload {baseline_s:.3f} s; photo / workload {out['photo_over_baseline']:.2f}")
     return out
 
 
 def main(quick: bool = False) -> dict:
-    return {"second_renderer": _second(10 if quick else 100),
-            "accuracy": _accuracy(30 if quick else 200),
+    return {"second_renderer": _second(10 if quick else 40),
+            "accuracy": _accuracy(30 if quick else 40),
             "refusals": _refusals(6 if quick else 40),
             "radius": _radius()}

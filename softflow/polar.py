@@ -16,6 +16,9 @@ import numpy as np
 
 from softflow.flow_checks import FlowMeasurementError
 
+MIN_WEDGE_FILL = 0.8
+MAX_WEDGE_OFFSET = 0.1
+
 
 def polar_coordinates(shape: tuple[int, int], center_px: tuple[float, float],
                       direction: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -61,26 +64,35 @@ def profiles(component: np.ndarray, radius_px: np.ndarray, beta: np.ndarray,
     """Per beta bin: (r centres px, median value, standard error) over r bins of ``step_px``.
 
     Standard error: 1.4826 MAD / sqrt(n / 25), ``n/25`` the number of independent
-    vectors (neighbours within a ~5 px flow window are correlated).
+    vectors (neighbours within a ~5 px flow window are correlated). An r bin is kept only
+    where its valid pixels fill the wedge evenly (at least ``MIN_WEDGE_FILL`` of the area
+    ``r * step * width``, their mean angle within ``MAX_WEDGE_OFFSET`` of the width from the
+    centre): a wedge cut by the image edge, the soil surface or a mask holds one side only,
+    and its median is the velocity off the bin centre (on the second renderer's exact field,
+    ``k`` 5 % low where the image bottom cut the ray).
     """
     ok = np.isfinite(component) & (radius_px >= r_min_px)
     out = []
     for b in beta_centres:
-        sel = ok & (np.abs(np.angle(np.exp(1j * (beta - b)))) <= width_rad / 2)
-        r, v = radius_px[sel], component[sel]
+        offset = np.angle(np.exp(1j * (beta - b)))
+        sel = ok & (np.abs(offset) <= width_rad / 2)
+        r, v, off = radius_px[sel], component[sel], offset[sel]
         if len(r) < 50:
             out.append((np.empty(0), np.empty(0), np.empty(0)))
             continue
         idx = ((r - r_min_px) // step_px).astype(int)
         order = np.argsort(idx, kind="stable")
-        idx, v = idx[order], v[order]
+        idx, v, off = idx[order], v[order], off[order]
         starts = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
         groups = np.split(v, starts[1:])
         n = np.array([len(g) for g in groups])
+        mean_off = np.add.reduceat(off, starts) / n
         med = np.array([np.median(g) for g in groups])
         mad = np.array([np.median(np.abs(g - m)) for g, m in zip(groups, med)])
-        keep = n >= 10
         rc = r_min_px + (idx[starts] + 0.5) * step_px
+        full = (n >= MIN_WEDGE_FILL * rc * step_px * width_rad) \
+            & (np.abs(mean_off) <= MAX_WEDGE_OFFSET * width_rad)
+        keep = (n >= 10) & full
         se = 1.4826 * mad / np.sqrt(np.maximum(n / 25, 1)) + 1e-9
         out.append((rc[keep], med[keep], se[keep]))
     return out

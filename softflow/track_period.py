@@ -17,6 +17,9 @@ from scipy.ndimage import gaussian_filter1d, maximum_filter1d, median_filter
 
 MIN_PEAK = 8.0  # a fundamental's own peak over the local median power (noise: p = 0.4 %)
 HARMONICS = 8
+MIN_COMB = 3.0  # prominence of a peak between a harmonic's multiples (noise: p about 0.2)
+MIN_COMB_SHARE = 0.8  # of those multiples
+MIN_COMB_OF_TOP = 0.15  # nor below this share of the best candidate's own prominence
 MIN_PROMINENCE = 60.0  # harmonic sum of peak-over-median ratios (noise on sand: 15-50)
 MIN_CORRELATION = 0.3  # a window holds a mark when it matches the mean waveform this well
 MIN_FIT_MARKS = 4  # for a fit with a residual
@@ -57,9 +60,13 @@ def fundamental(profile: np.ndarray, min_period: float, max_period: float) -> tu
     Every spectral peak in range at least ``MIN_PEAK`` times its background is a candidate;
     it scores the prominences of the peaks found at its first ``HARMONICS`` multiples
     (within half a bin plus a tenth of a bin per order). Sharp marks have strong harmonics,
-    so the lowest sub-multiple (up to a third) of the best candidate that is itself a
-    candidate scoring at least half as much is the fundamental; a sub-harmonic of the
-    marks has no peak of its own and is no candidate.
+    so the best candidate may be a harmonic; its lowest sub-multiple ``f/m`` is the
+    fundamental when either it is itself a candidate scoring at least half as much
+    (``m`` up to 3), or peaks of at least ``MIN_COMB`` times their background (and
+    ``MIN_COMB_OF_TOP`` of the best candidate's) stand at ``MIN_COMB_SHARE`` of the
+    multiples ``j f/m`` between (``j < max(2m, 8)``, not multiples of ``m``):
+    narrow grooves put more power in their 4th or 5th harmonic than in the fundamental,
+    while a sub-harmonic of the marks has noise there.
     """
     freq, power, ratio = prominence_spectrum(profile, max_period)
     peaks = np.flatnonzero((ratio == maximum_filter1d(ratio, 2 * PAD + 1)) & (ratio > 1))
@@ -68,22 +75,36 @@ def fundamental(profile: np.ndarray, min_period: float, max_period: float) -> tu
     if candidates.size == 0:
         return 0.0, 0.0
     order = np.arange(1, HARMONICS + 1)
-    target = np.outer(candidates, order)  # in padded bins
-    nearest = peaks[np.clip(np.searchsorted(peaks, target), 1, peaks.size - 1) - 1]
-    after = peaks[np.clip(np.searchsorted(peaks, target), 0, peaks.size - 1)]
-    nearest = np.where(np.abs(after - target) < np.abs(nearest - target), after, nearest)
-    on_comb = np.abs(nearest - target) <= PAD * (0.5 + 0.1 * order)
-    score = np.where(on_comb, ratio[nearest], 0.0).sum(axis=1)
+
+    def comb(bin_: float, orders: np.ndarray, tolerance: np.ndarray) -> np.ndarray:
+        """Prominence of the nearest peak at each multiple, 0 where none is that close."""
+        target = bin_ * orders  # in padded bins
+        at = np.clip(np.searchsorted(peaks, target), 0, peaks.size - 1)
+        before = peaks[np.maximum(at - 1, 0)]
+        nearest = np.where(np.abs(peaks[at] - target) < np.abs(before - target),
+                           peaks[at], before)
+        return np.where(np.abs(nearest - target) <= tolerance, ratio[nearest], 0.0)
+
+    score = np.array([comb(c, order, PAD * (0.5 + 0.1 * order)).sum() for c in candidates])
     best = int(np.argmax(score))
-    for m in range(min(int(freq[candidates[best]] * max_period), 3), 1, -1):
-        sub = np.flatnonzero(np.abs(candidates - candidates[best] / m) <= PAD * 0.5)
-        if sub.size and score[sub].max() >= 0.5 * score[best]:
-            best = int(sub[np.argmax(score[sub])])
+    top = candidates[best]
+    chosen, chosen_score = float(top), score[best]
+    for m in range(int(freq[top] * max_period), 1, -1):
+        sub = np.flatnonzero(np.abs(candidates - top / m) <= PAD * 0.5)
+        if m <= 3 and sub.size and score[sub].max() >= 0.5 * score[best]:
+            j = sub[np.argmax(score[sub])]
+            chosen, chosen_score = float(candidates[j]), score[j]
             break
-    i = candidates[best]
+        between = np.array([j for j in range(1, max(2 * m, HARMONICS)) if j % m])
+        floor = max(MIN_COMB, MIN_COMB_OF_TOP * ratio[top])
+        if np.mean(comb(top / m, between, PAD * 0.75) >= floor) >= MIN_COMB_SHARE:
+            chosen = top / m
+            chosen_score = comb(chosen, order, PAD * (0.5 + 0.1 * order)).sum()
+            break
+    i = int(np.clip(round(chosen), 1, power.size - 2))
     lo, mid, hi = np.log(power[i - 1:i + 2])
     shift = 0.5 * (lo - hi) / (lo - 2 * mid + hi) if lo - 2 * mid + hi < 0 else 0.0
-    return float(freq[i] + shift * freq[1]), float(score[best])
+    return float(freq[i] + shift * freq[1]), float(chosen_score)
 
 
 def _harmonics(profile: np.ndarray, period: float, count: int) -> np.ndarray:
@@ -97,18 +118,22 @@ def _harmonics(profile: np.ndarray, period: float, count: int) -> np.ndarray:
 
 
 def _robust_fit(k: np.ndarray, x: np.ndarray, floor: float) -> np.ndarray:
-    """Inlier mask of a quadratic ``x(k)`` after iterated rejection beyond 3 sigma (MAD),
-    never tighter than ``floor``."""
+    """Inlier mask of ``x(k)`` after iterated rejection beyond 3 sigma (MAD), never tighter
+    than ``floor``. It starts from a Theil-Sen line (Sen 1968, J. Am. Stat. Assoc. 63), so a
+    stray mark at an end of the track cannot pull the first fit, and refits with the degree
+    of the final fit (a quadratic from ``MIN_QUADRATIC_MARKS`` marks)."""
+    i, j = np.triu_indices(k.size, 1)
+    slope = np.median((x[j] - x[i]) / (k[j] - k[i]))
+    res = x - slope * k - np.median(x - slope * k)
     keep = np.ones(k.size, bool)
-    for _ in range(4):
-        if keep.sum() < MIN_FIT_MARKS:
-            break
-        res = x - np.polyval(np.polyfit(k[keep], x[keep], 2), k)
+    for _ in range(5):
         sigma = 1.4826 * np.median(np.abs(res[keep] - np.median(res[keep])))
         new = np.abs(res) <= max(3 * sigma, floor)
-        if np.array_equal(new, keep):
+        if np.array_equal(new, keep) or new.sum() < MIN_FIT_MARKS:
             break
         keep = new
+        degree = 2 if keep.sum() >= MIN_QUADRATIC_MARKS else 1
+        res = x - np.polyval(np.polyfit(k[keep], x[keep], degree), k)
     return keep
 
 
