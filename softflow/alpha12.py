@@ -64,13 +64,14 @@ def fit_alpha12(eps: np.ndarray, k_per_m: np.ndarray, k_sigma_per_m: np.ndarray)
 
 
 def fit_alpha12_across_runs(results: Sequence) -> dict | None:
-    """One line through the (eps, k) bins of several ``FlowResult``s (with ``eps_vol_p``)."""
+    """One line through the (eps, k) bins of several ``FlowResult``s (with ``eps_vol_p``),
+    over the bins whose ``eps`` is resolved (``FlowResult.resolved_eps``)."""
     eps, k, sigma = [], [], []
     for res in results:
         if res.eps_vol_p is None:
             continue
         rk, rs = rates_and_sigmas(res.radial)
-        eps.append(np.asarray(res.eps_vol_p, np.float64))
+        eps.append(np.asarray(res.resolved_eps(), np.float64))
         k.append(rk)
         sigma.append(rs)
     if not eps:

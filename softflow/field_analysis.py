@@ -7,7 +7,8 @@ frame and resolve about the axle (:mod:`softflow.polar`), fit ``k(beta)`` and
 effective-radius models (:mod:`softflow.grouser_models`). ``eps_vol^P(beta)`` is
 given or estimated from the measured field (:mod:`softflow.volumetric_strain`), and
 ``1/k = eps/alpha1 + alpha2/alpha1`` is regressed over beta (alpha1, alpha2
-constant; :mod:`softflow.alpha12`) to separate ``alpha1`` and ``alpha2``.
+constant; :mod:`softflow.alpha12`) to separate ``alpha1`` and ``alpha2``, over the
+bins whose estimated ``eps`` is resolved to 0.01 (:func:`softflow.flow_checks.eps_reason`).
 """
 
 from __future__ import annotations
@@ -19,7 +20,8 @@ import numpy as np
 
 from softflow.alpha12 import fit_alpha12, rates_and_sigmas
 from softflow.decay_fit import DecayFit, fit_decay
-from softflow.flow_checks import check_contact_fits, check_sled_velocity, fit_reason
+from softflow.flow_checks import (alpha12_reason, check_contact_fits, check_sled_velocity,
+                                  eps_reason, fit_reason)
 from softflow.flow_engine import MeanField, average_flow
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
@@ -58,12 +60,17 @@ class FlowResult:
     eps_vol_p: np.ndarray | None = None  # per beta bin, compression positive
     eps_source: str | None = None  # "given" or "estimated"
     eps_depth_m: float | None = None  # estimated: taken this far outside the wheel
+    eps_bound: np.ndarray | None = None  # estimated: uncertainty bound per beta bin
+    eps_reason: list = field(default_factory=list)  # per bin: why eps is not resolved
+    alpha12_reason: str | None = None  # why alpha12 is None
     radial_reason: list = field(default_factory=list)  # per bin: why no k (None: fitted)
     tangential_reason: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         p0 = self.poses[0]
-        eps = np.full(len(self.beta_rad), np.nan) if self.eps_vol_p is None else self.eps_vol_p
+        nan = np.full(len(self.beta_rad), np.nan)
+        eps = nan if self.eps_vol_p is None else self.eps_vol_p
+        bound = nan if self.eps_bound is None else self.eps_bound
         return {
             "schema": "swtlab.softflow/1",
             "source": self.source,
@@ -87,11 +94,15 @@ class FlowResult:
                  "k_reason": rr,
                  "alpha3": t.to_dict() if t else None,
                  "alpha3_reason": tr,
-                 "eps_vol_p": None if np.isnan(e) else float(e)}
-                for b, r, t, e, rr, tr in zip(self.beta_rad, self.radial, self.tangential, eps,
-                                              self._reasons(self.radial_reason),
-                                              self._reasons(self.tangential_reason))],
+                 "eps_vol_p": None if np.isnan(e) else float(e),
+                 "eps_vol_p_bound": None if np.isnan(eb) else float(eb),
+                 "eps_vol_p_reason": er}
+                for b, r, t, e, eb, rr, tr, er in zip(
+                    self.beta_rad, self.radial, self.tangential, eps, bound,
+                    self._reasons(self.radial_reason), self._reasons(self.tangential_reason),
+                    self._reasons(self.eps_reason))],
             "alpha1_alpha2": self.alpha12,
+            "alpha1_alpha2_reason": self.alpha12_reason,
             "eps_vol_p_source": self.eps_source,
             "eps_vol_p_depth_m": self.eps_depth_m,
             "grouser_model": self.grouser,
@@ -100,6 +111,13 @@ class FlowResult:
 
     def _reasons(self, reasons: list) -> list:
         return reasons or [None] * len(self.beta_rad)
+
+    def resolved_eps(self) -> np.ndarray | None:
+        """``eps_vol_p`` where it is resolved (``eps_reason`` None), else NaN."""
+        if self.eps_vol_p is None:
+            return None
+        return np.where([r is None for r in self._reasons(self.eps_reason)], self.eps_vol_p,
+                        np.nan)
 
 
 def _rates(fits: list[DecayFit | None]) -> np.ndarray:
@@ -164,14 +182,20 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
     else:
         depth_m = rim / px_per_m / 5 if eps_depth_m is None else eps_depth_m
         below = centres < 0  # a bin has soil below the axle only
-        result.eps_vol_p = np.full(len(centres), np.nan)
-        result.eps_vol_p[below] = strain_by_beta(
+        result.eps_vol_p, result.eps_bound = np.full((2, len(centres)), np.nan)
+        result.eps_vol_p[below], result.eps_bound[below] = strain_by_beta(
             mean.velocity_px_per_s, center, rim + poses[0].grouser_height_px + depth_m * px_per_m,
             centres[below], width, -np.asarray(sled) * px_per_m)
+        result.eps_reason = [eps_reason(e, b) if low else "not estimated above the axle"
+                             for e, b, low in zip(result.eps_vol_p, result.eps_bound, below)]
         result.eps_source, result.eps_depth_m = "estimated", depth_m
-    result.alpha12 = fit_alpha12(result.eps_vol_p, *rates_and_sigmas(radial))
+    k_per_m, k_sigma_per_m = rates_and_sigmas(radial)
+    result.alpha12 = fit_alpha12(result.resolved_eps(), k_per_m, k_sigma_per_m)
     if result.alpha12:
         result.alpha12["eps_source"] = result.eps_source
+    else:
+        result.alpha12_reason = alpha12_reason(result.eps_reason or [None] * len(centres),
+                                               np.isfinite(k_per_m))
     if poses[0].grouser_count and poses[0].grouser_height_px > 0:
         result.grouser = _grouser_selection(result, frames[0].shape, direction, r_min)
     return result

@@ -85,5 +85,6 @@ def unpack_flow(data: dict, blob: bytes) -> tuple[FlowResult, np.ndarray]:
         radial=[_fit(row["k"]) for row in per_beta],
         tangential=[_fit(row["alpha3"]) for row in per_beta],
         profiles_r=profiles["r"], profiles_t=profiles["t"], grouser=data["grouser_model"],
-        alpha12=data["alpha1_alpha2"], engine=data["engine"], source=data["source"])
+        alpha12=data["alpha1_alpha2"], alpha12_reason=data.get("alpha1_alpha2_reason"),
+        engine=data["engine"], source=data["source"])
     return result, frame

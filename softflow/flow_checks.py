@@ -9,6 +9,9 @@ Thresholds: a component's rate is defined where its rim velocity is at least 30 
 the travel velocity (swtlab issue 21; for ``v_r`` the rim value is ``V sin(theta)``,
 for ``v_theta`` the fitted rim amplitude ``V cos(theta) - R omega``); a fit is kept
 with R² >= 0.5 and a 95 % CI narrower than the rate itself (half-width < 50 %).
+An estimated ``eps_vol^P`` is resolved where its uncertainty bound
+(:func:`softflow.volumetric_strain.strain_by_beta`) is at most 0.01 (issue 21: sand
+compacts by about 0.01-0.15); only resolved bins go into alpha1 and alpha2.
 """
 
 from __future__ import annotations
@@ -24,6 +27,8 @@ MAX_CI_HALF_FRACTION = 0.5
 MAX_VERTICAL_FRACTION = 0.1
 #: spread (IQR / 1.349 of the far-field speed along travel) above this fraction: not one motion
 MAX_FAR_SPREAD_FRACTION = 0.1
+#: largest uncertainty bound of an estimated eps_vol^P that counts as resolved
+EPS_RESOLUTION = 0.01
 #: contact region of the checks, image angle beta (deg): below the axle
 CONTACT_BETA_DEG = (-160.0, -20.0)
 
@@ -62,6 +67,29 @@ def fit_reason(fit: DecayFit | None, points: int, rim_fraction: float) -> str | 
     if half > MAX_CI_HALF_FRACTION * fit.rate_per_m:
         return f"rate not resolved (95 % CI +-{half:.1f} /m on {fit.rate_per_m:.1f} /m)"
     return None
+
+
+def eps_reason(eps: float, bound: float) -> str | None:
+    """Why an estimated bin's ``eps_vol^P`` is not resolved (None: it is)."""
+    if not np.isfinite(eps):
+        return "no value (no streamline from undisturbed soil upstream)"
+    if not np.isfinite(bound):
+        return "no uncertainty bound (no value at twice the smoothing scale)"
+    if bound > EPS_RESOLUTION:
+        return (f"not resolvable: {eps:.3f} +- {bound:.3f} (smoothing bias, scatter and strain "
+                f"left upstream; > {EPS_RESOLUTION})")
+    return None
+
+
+def alpha12_reason(eps_reasons: list, k_ok: np.ndarray) -> str:
+    """Why alpha1 and alpha2 are not given: fewer than 3 bins with a resolved eps and a k."""
+    with_k = [r for r, ok in zip(eps_reasons, k_ok) if ok]
+    unresolved = sum(1 for r in with_k if r and r.startswith("not resolvable"))
+    usable = sum(1 for r in with_k if r is None)
+    if unresolved:
+        return (f"eps_vol^P not resolvable to {EPS_RESOLUTION} in {unresolved} of the "
+                f"{len(with_k)} bins with a k fit ({usable} left, 3 needed)")
+    return f"fewer than 3 bins with both eps_vol^P and a k fit ({usable})"
 
 
 def in_contact(beta_rad: np.ndarray) -> np.ndarray:

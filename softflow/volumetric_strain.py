@@ -23,12 +23,22 @@ far-field velocity ``-V`` (1D continuity: about 0.01 of strain left out), else n
 value (ending on the wheel, or on an image edge where the soil still moves). A path
 that comes closer to the axle than its start also gives no value: it ran along the
 rim, where the flow is least reliable (behind the wheel).
+
+Uncertainty bound per bin (what says whether ``eps`` is resolved, without a truth):
+smoothing bias + scatter + strain left upstream. The gradient of a Gaussian plane fit
+is biased by ``sigma^2/2 grad(laplacian u)`` inside the field (odd moments of the
+window vanish) and by about ``sigma`` times the second derivative where the window is
+one-sided (mask edge); ``eps(2 sigma) - eps(sigma)`` is then 3 times or once the bias at
+``sigma``, so its magnitude bounds it in both cases (Richardson's step doubling,
+Richardson 1911, Phil. Trans. R. Soc. A 210). Scatter: 95 % half-width of the mean over
+the bin's samples (Student t). Left upstream: where a path ends, 1D continuity
+(``rho |u|`` constant) gives the strain still to come as ``|ln(|u_end| / |V|)|``.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, stats
 
 SIGMA_PX = 5.0  # derivative scale: smallest eps error on renders (docs/softflow.md)
 UNDISTURBED = 0.01  # |u + V| / |V| where a streamline may end
@@ -81,15 +91,17 @@ def smoothed_divergence(velocity: np.ndarray,
 
 def accumulated_strain(velocity: np.ndarray, divergence: np.ndarray, start_xy: np.ndarray,
                        far_velocity: np.ndarray, keep_out: np.ndarray | None = None,
-                       step_px: float = 1.0) -> np.ndarray:
-    """``eps`` (compression positive) at each start point (N, 2: x, y); NaN without an
-    undisturbed upstream end or where the path enters ``keep_out`` (bool map).
+                       step_px: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """``eps`` (compression positive) at each start point (N, 2: x, y) and the strain left
+    upstream of its end, ``|ln(|u_end| / |V|)|``; NaN without an undisturbed upstream end or
+    where the path enters ``keep_out`` (bool map).
     ``velocity``: steady camera frame; ``far_velocity``: ``-V``.
     """
     x, y = start_xy[:, 0].astype(np.float64), start_xy[:, 1].astype(np.float64)
     eps = np.zeros(len(x))
     end = np.full(len(x), -1)  # -1 still tracing; 0 no value; 1 undisturbed end
     calm = np.zeros(len(x), bool)  # at the last point with a velocity: undisturbed soil
+    speed_end = np.full(len(x), np.nan)  # |u| there
     far = np.asarray(far_velocity, np.float64)
 
     def upstream(px, py):  # unit step direction (against u) and d eps / ds
@@ -110,6 +122,7 @@ def accumulated_strain(velocity: np.ndarray, divergence: np.ndarray, start_xy: n
         here = np.isfinite(a[2])
         calm[idx[here]] = (np.hypot(a[3] - far[0], a[4] - far[1])
                            <= UNDISTURBED * np.hypot(*far))[here]
+        speed_end[idx[here]] = np.hypot(a[3], a[4])[here]
         stop = ~here | ~np.isfinite(b[2])
         end[idx[stop]] = calm[idx[stop]]
         if keep_out is not None:
@@ -121,19 +134,16 @@ def accumulated_strain(velocity: np.ndarray, divergence: np.ndarray, start_xy: n
         x[go] += step_px * b[0][~stop]
         y[go] += step_px * b[1][~stop]
         eps[go] += step_px * b[2][~stop]
-    return np.where(end == 1, eps, np.nan)
+    done = end == 1
+    left = np.abs(np.log(speed_end / np.hypot(*far)))
+    return np.where(done, eps, np.nan), np.where(done, left, np.nan)
 
 
-def strain_by_beta(velocity_px_per_s: np.ndarray, center_px: tuple[float, float],
-                   radius_px: float, beta_centres: np.ndarray, width_rad: float,
-                   far_velocity_px_per_s: np.ndarray, sigma_px: float = SIGMA_PX) -> np.ndarray:
-    """``eps`` per beta bin at ``radius_px`` from the axle: mean over 5 angles across the bin
-    (NaN where fewer than 3 have an undisturbed upstream end). Paths that come closer
-    to the wheel than their start (behind the wheel: soil that slid along the rim,
-    where the flow is least reliable) give no value.
-
-    ``velocity_px_per_s``: mean camera-frame field (H, W, 2), NaN where masked.
-    """
+def _bin_samples(velocity_px_per_s: np.ndarray, center_px: tuple[float, float],
+                 radius_px: float, beta_centres: np.ndarray, width_rad: float,
+                 far_velocity_px_per_s: np.ndarray,
+                 sigma_px: float) -> tuple[np.ndarray, np.ndarray]:
+    """``eps`` and strain left upstream at 5 angles across each bin (bins, 5); NaN: no value."""
     u, div = smoothed_divergence(velocity_px_per_s, sigma_px)
     inner = np.zeros(div.shape, bool)
     inner[BORDER_PX:-BORDER_PX, BORDER_PX:-BORDER_PX] = True
@@ -144,8 +154,39 @@ def strain_by_beta(velocity_px_per_s: np.ndarray, center_px: tuple[float, float]
                       center_px[1] - radius_px * np.sin(beta)], -1)
     y, x = np.mgrid[0:div.shape[0], 0:div.shape[1]]
     near = np.hypot(x - center_px[0], y - center_px[1]) < radius_px - CLOSER_PX
-    eps = accumulated_strain(u, div, start, far_velocity_px_per_s, near)
-    eps = eps.reshape(-1, len(offsets))
-    count = np.isfinite(eps).sum(axis=1)
-    total = np.nansum(eps, axis=1)
-    return np.where(count >= 3, total / np.maximum(count, 1), np.nan)
+    eps, left = accumulated_strain(u, div, start, far_velocity_px_per_s, near)
+    return eps.reshape(-1, len(offsets)), left.reshape(-1, len(offsets))
+
+
+def strain_by_beta(velocity_px_per_s: np.ndarray, center_px: tuple[float, float],
+                   radius_px: float, beta_centres: np.ndarray, width_rad: float,
+                   far_velocity_px_per_s: np.ndarray,
+                   sigma_px: float = SIGMA_PX) -> tuple[np.ndarray, np.ndarray]:
+    """``eps`` per beta bin at ``radius_px`` from the axle and its uncertainty bound
+    (smoothing bias + scatter + strain left upstream, module docstring). ``eps``: mean over
+    5 angles across the bin, NaN where fewer than 3 have an undisturbed upstream end; the
+    bound is NaN where ``eps`` is, or where the ``2 sigma`` pass has no value. Paths that
+    come closer to the wheel than their start (behind the wheel: soil that slid along the
+    rim, where the flow is least reliable) give no value.
+
+    ``velocity_px_per_s``: mean camera-frame field (H, W, 2), NaN where masked.
+    """
+    args = (velocity_px_per_s, center_px, radius_px, beta_centres, width_rad,
+            far_velocity_px_per_s)
+    samples, left = _bin_samples(*args, sigma_px)
+    coarse = _bin_mean(_bin_samples(*args, 2 * sigma_px)[0])
+    eps = _bin_mean(samples)
+    count = np.isfinite(samples).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scatter = (stats.t.ppf(0.975, np.maximum(count - 1, 1))
+                   * np.nanstd(np.where(count[:, None] >= 3, samples, 0.0), axis=1, ddof=1)
+                   / np.sqrt(np.maximum(count, 1)))
+        bound = np.abs(coarse - eps) + scatter + np.nanmean(
+            np.where(count[:, None] >= 3, left, 0.0), axis=1)
+    return eps, np.where(np.isfinite(eps), bound, np.nan)
+
+
+def _bin_mean(samples: np.ndarray) -> np.ndarray:
+    """Mean per row over the finite samples; NaN where fewer than 3."""
+    count = np.isfinite(samples).sum(axis=1)
+    return np.where(count >= 3, np.nansum(samples, axis=1) / np.maximum(count, 1), np.nan)

@@ -58,6 +58,10 @@ def test_alpha1_alpha2_from_given_strain(smooth_wheel):
     res = analyse_frames(r.frames[:4], r.t_s[:4], scene.px_per_m, eps_vol_by_beta=eps)
     assert res.alpha12["alpha1_per_m"] == pytest.approx(alpha1, rel=1e-6)
     assert res.alpha12["alpha2"] == pytest.approx(alpha2, rel=1e-6)
+    data = res.to_dict()  # a given strain is taken as resolved
+    assert data["alpha1_alpha2_reason"] is None
+    assert all(row["eps_vol_p_reason"] is None and row["eps_vol_p_bound"] is None
+               for row in data["per_beta"])
 
 
 @pytest.mark.parametrize("model, seed", [("piecewise", 100), ("gear", 103)])

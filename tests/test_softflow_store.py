@@ -123,6 +123,8 @@ def test_flow_stored_against_truth_failures_reported_rerun_stores_nothing(campai
                                                             rel=SLED)
             assert row.px_per_m == side["scene"]["px_per_m"] and row.grouser_model is not None
             assert row.result["frame_range"] == [0, 6] and len(row.fits) > 40
+            assert row.alpha12_problem == row.result["alpha1_alpha2_reason"]
+            assert (row.alpha1_per_m is None) == (row.alpha12_problem is not None)
             for component in ("k", "alpha3"):
                 errors = _errors(row, side, component)
                 assert len(errors) >= MIN_BINS, (run_id, component, errors)

@@ -357,6 +357,8 @@ class SoilFlow(Base):
     grouser_gamma: Mapped[float | None] = mapped_column(Float, nullable=True)
     alpha1_per_m: Mapped[float | None] = mapped_column(Float, nullable=True)
     alpha2: Mapped[float | None] = mapped_column(Float, nullable=True)
+    #: why alpha1 and alpha2 are blank (e.g. eps_vol^P not resolvable to 0.01); None: given
+    alpha12_problem: Mapped[str | None] = mapped_column(String(MESSAGE_CHARS), nullable=True)
     result: Mapped[dict] = mapped_column(JSON)
     field_npz: Mapped[bytes] = mapped_column(LargeBinary)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))

@@ -45,7 +45,7 @@ def store_flow(session: Session, raw_file: RawFile, window: StableWindow, result
         wheel_center_y_px=float(pose.center_px[1]), wheel_radius_px=float(pose.radius_px),
         grouser_model=grouser.get("chosen"), grouser_margin_percent=grouser.get("margin_percent"),
         grouser_gamma=grouser.get("gamma"), alpha1_per_m=alpha12.get("alpha1_per_m"),
-        alpha2=alpha12.get("alpha2"), result=data,
+        alpha2=alpha12.get("alpha2"), alpha12_problem=data["alpha1_alpha2_reason"], result=data,
         field_npz=field_npz,
         processing=new_processing_record(session, "flow", parameters),
         fits=_fits(data["per_beta"]))
