@@ -26,7 +26,7 @@ from softflow.flow_engine import MeanField, average_flow
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
 from softflow.threads import capped
-from softflow.volumetric_strain import strain_by_beta
+from softflow.volumetric_strain import FLOW_FIELD_ERROR, strain_by_beta
 from softflow.wheel_detect import (MASK_MARGIN_PX, WheelPose, smooth_pixels, soil_mask,
                                    track_wheel)
 
@@ -186,6 +186,7 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
         result.eps_vol_p[below], result.eps_bound[below] = strain_by_beta(
             mean.velocity_px_per_s, center, rim + poses[0].grouser_height_px + depth_m * px_per_m,
             centres[below], width, -np.asarray(sled) * px_per_m)
+        result.eps_bound += FLOW_FIELD_ERROR  # the field is measured, not exact
         result.eps_reason = [eps_reason(e, b) if low else "not estimated above the axle"
                              for e, b, low in zip(result.eps_vol_p, result.eps_bound, below)]
         result.eps_source, result.eps_depth_m = "estimated", depth_m

@@ -10,8 +10,9 @@ the travel velocity (swtlab issue 21; for ``v_r`` the rim value is ``V sin(theta
 for ``v_theta`` the fitted rim amplitude ``V cos(theta) - R omega``); a fit is kept
 with R² >= 0.5 and a 95 % CI narrower than the rate itself (half-width < 50 %).
 An estimated ``eps_vol^P`` is resolved where its uncertainty bound
-(:func:`softflow.volumetric_strain.strain_by_beta`) is at most 0.01 (issue 21: sand
-compacts by about 0.01-0.15); only resolved bins go into alpha1 and alpha2.
+(:func:`softflow.volumetric_strain.strain_by_beta`, plus ``FLOW_FIELD_ERROR``) is at most
+0.01 (issue 21: sand compacts by about 0.01-0.15); only resolved bins go into alpha1 and
+alpha2.
 """
 
 from __future__ import annotations
@@ -76,8 +77,8 @@ def eps_reason(eps: float, bound: float) -> str | None:
     if not np.isfinite(bound):
         return "no uncertainty bound (no value at twice the smoothing scale)"
     if bound > EPS_RESOLUTION:
-        return (f"not resolvable: {eps:.3f} +- {bound:.3f} (smoothing bias, scatter and strain "
-                f"left upstream; > {EPS_RESOLUTION})")
+        return (f"not resolvable: {eps:.3f} +- {bound:.3f} (smoothing bias, scatter, strain "
+                f"left upstream, flow-field error; > {EPS_RESOLUTION})")
     return None
 
 

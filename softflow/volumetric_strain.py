@@ -33,6 +33,8 @@ one-sided (mask edge); ``eps(2 sigma) - eps(sigma)`` is then 3 times or once the
 Richardson 1911, Phil. Trans. R. Soc. A 210). Scatter: 95 % half-width of the mean over
 the bin's samples (Student t). Left upstream: where a path ends, 1D continuity
 (``rho |u|`` constant) gives the strain still to come as ``|ln(|u_end| / |V|)|``.
+A field measured from frames adds the flow engine's own error, the same across a bin and
+so not in the scatter: ``FLOW_FIELD_ERROR`` (measured on renders, docs/softflow.md).
 """
 
 from __future__ import annotations
@@ -45,6 +47,9 @@ UNDISTURBED = 0.01  # |u + V| / |V| where a streamline may end
 BORDER_PX = 8  # dropped at the image edge: flow windows cut by the border
 CLOSER_PX = 2.0  # a path may come this much closer to the axle than its start point
 SAMPLES_PER_BIN = 5
+#: eps error of a field measured from frames beyond the exact field's, worst bin on the
+#: self-consistent renders (seeds 11, 12, 21; eps 0.37-0.67): 0.026 at seed 12, beta -105 deg
+FLOW_FIELD_ERROR = 0.026
 
 
 def local_linear_fit(field: np.ndarray, valid: np.ndarray, sigma_px: float = SIGMA_PX,

@@ -5,7 +5,9 @@ Tolerances are measured (docs/softflow.md, "alpha1 and alpha2"): on 7 renders li
 these (seeds 11-41, 7 pairs, default engine) the worst eps error per bin was 0.029
 and two runs pooled gave alpha1 within 8 % and alpha2 within 0.06 of the truth. That
 strain (0.37-0.63) is not resolved to 0.01 by the estimate's own bound, so the analysis
-gives no alpha1, alpha2 there (issue 21 item 3); a realistic 0.05 on a closed-form field is.
+gives no alpha1, alpha2 there (issue 21 item 3); a realistic 0.05 on an exact closed-form
+field is, but a field measured from frames adds the flow engine's error (0.026, measured
+on these renders), more than 0.01 alone.
 """
 
 from __future__ import annotations
@@ -142,6 +144,8 @@ def test_eps_from_frames_against_truth(runs):
         assert ok.sum() >= 8 and beta.max() < 0  # the front half below the axle
         err = result.eps_vol_p[ok] - _truth_eps(render, beta)
         assert np.abs(err).max() < 0.05, err
+        # measured: worst error 0.022 (slip 0.6: 0.030), smallest bound 0.038 (0.041)
+        assert np.all(np.abs(err) <= result.eps_bound[ok])
         assert result.eps_source == "estimated" and result.eps_depth_m == pytest.approx(0.02)
 
 
