@@ -152,12 +152,24 @@ def limit_threads(threads: int) -> None:
     threadpool_limits(limits=threads)
 
 
+#: imported once by the process that starts the workers, before any of them
+WORKER_PRELOAD = ["swtlab.pipeline.process", "ingest", "run_results", "softflow"]
+
+
 def worker_pool(workers: int) -> ProcessPoolExecutor:
     """``workers`` processes, each limited to its share of this process's cores
-    (``swtlab.cores.threads_per_worker``)."""
+    (``swtlab.cores.threads_per_worker``). They start from a fresh ``forkserver`` with the
+    libraries imported, not forked from this process: a worker forked after this process ran
+    OpenCV's thread pool hangs when it resizes the inherited pool (``cv2.setNumThreads``)."""
+    import multiprocessing
+
     from swtlab.cores import threads_per_worker
 
-    return ProcessPoolExecutor(workers, initializer=limit_threads,
+    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    context = multiprocessing.get_context(method)
+    if method == "forkserver":
+        context.set_forkserver_preload(WORKER_PRELOAD)
+    return ProcessPoolExecutor(workers, mp_context=context, initializer=limit_threads,
                                initargs=(threads_per_worker(workers),))
 
 
