@@ -13,6 +13,7 @@ count (every parallel loop writes its own rows).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 
 import cv2
@@ -24,9 +25,25 @@ from swtlab.cores import available_cores
 def limit(threads: int) -> None:
     """numba and OpenCV on at most ``threads`` threads in this process from now on (numba's
     count is per calling thread: call it from the thread that runs the kernels). softflow's
-    import has chosen numba's fork-safe workqueue layer before this starts its threads."""
+    import has chosen numba's fork-safe workqueue layer before this starts its threads.
+    OpenCV's count is left as it is when it is ``threads`` already (inherited, see
+    :func:`opencv_threads`)."""
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    if cv2.getNumThreads() != max(1, threads):
+        cv2.setNumThreads(max(1, threads))
+
+
+@contextlib.contextmanager
+def opencv_threads(threads: int):
+    """OpenCV on ``threads`` threads in this process for the block, and in the processes it
+    forks meanwhile. Set it before the fork: a child forked after its parent used OpenCV's
+    thread pool hangs when it resizes the pool it inherited (``cv2.setNumThreads``)."""
+    before = cv2.getNumThreads()
     cv2.setNumThreads(max(1, threads))
+    try:
+        yield
+    finally:
+        cv2.setNumThreads(before)
 
 
 def capped(fn):

@@ -9,6 +9,7 @@ import dataclasses
 import tomllib
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -152,25 +153,19 @@ def limit_threads(threads: int) -> None:
     threadpool_limits(limits=threads)
 
 
-#: imported once by the process that starts the workers, before any of them
-WORKER_PRELOAD = ["swtlab.pipeline.process", "ingest", "run_results", "softflow"]
-
-
-def worker_pool(workers: int) -> ProcessPoolExecutor:
+@contextmanager
+def worker_pool(workers: int) -> Iterator[ProcessPoolExecutor]:
     """``workers`` processes, each limited to its share of this process's cores
-    (``swtlab.cores.threads_per_worker``). They start from a fresh ``forkserver`` with the
-    libraries imported, not forked from this process: a worker forked after this process ran
-    OpenCV's thread pool hangs when it resizes the inherited pool (``cv2.setNumThreads``)."""
-    import multiprocessing
-
+    (``swtlab.cores.threads_per_worker``). OpenCV's share is set here too while the pool
+    runs, for the workers forked from this process to inherit (see
+    ``softflow.threads.opencv_threads``)."""
+    from softflow.threads import opencv_threads
     from swtlab.cores import threads_per_worker
 
-    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-    context = multiprocessing.get_context(method)
-    if method == "forkserver":
-        context.set_forkserver_preload(WORKER_PRELOAD)
-    return ProcessPoolExecutor(workers, mp_context=context, initializer=limit_threads,
-                               initargs=(threads_per_worker(workers),))
+    threads = threads_per_worker(workers)
+    with opencv_threads(threads), ProcessPoolExecutor(
+            workers, initializer=limit_threads, initargs=(threads,)) as pool:
+        yield pool
 
 
 def _process(path: Path, settings: ProcessSettings, content: tuple[str, int] | None,
