@@ -29,6 +29,7 @@ from mcap.reader import make_reader
 
 import ingest
 from bench.bench_ingest import _campaign
+from swtlab.cores import threads_per_worker
 from swtlab.pipeline.process import ProcessSettings, process_file
 from swtlab_cli.main import main as swtlab
 
@@ -156,11 +157,15 @@ def main(quick: bool = False) -> dict:
     print(f"per-run CPU, swtlab / naive (1 kHz synthetic): {cpu_ratio:.2f} (goal <= 0.5)")
     print(f"throughput --jobs 2 / --jobs 1 (1 kHz synthetic): {speedup:.2f} measured (wall, "
           f"on a machine with load {os.getloadavg()[0]:.1f}), {idle_speedup:.2f} on 2 idle "
-          "cores from the CPU seconds (goal >= 1.7 on 2 idle cores)")
+          "cores from the CPU seconds (goal >= 1.7 on 2 idle cores); numba, OpenCV and BLAS "
+          f"threads per worker: {threads_per_worker(1)} with --jobs 1, "
+          f"{threads_per_worker(2)} with --jobs 2")
     print(f"swtlab --help {help_s:.3f} s, python -c pass {pass_s:.3f} s: "
           f"{help_s / pass_s:.1f}x (goal: <= 0.3 s)")
     out["summary"] = {"cpu_ratio_vs_naive": cpu_ratio, "jobs2_over_jobs1_throughput": speedup,
                       "jobs2_over_jobs1_idle_cores_from_cpu": idle_speedup,
+                      "threads_per_worker_jobs1": threads_per_worker(1),
+                      "threads_per_worker_jobs2": threads_per_worker(2),
                       "load_average": os.getloadavg()[0],
                       "help_s": help_s, "python_pass_s": pass_s,
                       "help_over_pass": help_s / pass_s}

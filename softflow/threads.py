@@ -4,20 +4,46 @@ numba sizes its thread pool once, from the CPU affinity at import, and OpenCV fr
 machine's CPUs; a process pinned later (``taskset``, ``os.sched_setaffinity``, a cluster
 worker given fewer cores) would run more threads than it has cores, and a parallel loop is
 only as fast as its slowest thread (issue 19 item 6: on a busy 2-core machine, 2 threads
-took 2.4x the time of one). :func:`capped` runs a function with numba's and
-OpenCV's threads at most ``swtlab.cores.available_cores()`` (never more than the caller set), and
-restores them after. The results do not depend on the thread count (every parallel loop
-writes its own rows).
+took 2.4x the time of one). :func:`capped` runs a function with numba's and OpenCV's
+threads at most ``swtlab.cores.available_cores()`` (never more than the caller set), and
+restores them after; :func:`limit` sets them for the rest of the process (a ``swtlab
+process --jobs`` worker's share of the cores). The results do not depend on the thread
+count (every parallel loop writes its own rows).
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 
 import cv2
 import numba
 
 from swtlab.cores import available_cores
+
+
+def limit(threads: int) -> None:
+    """numba and OpenCV on at most ``threads`` threads in this process from now on (numba's
+    count is per calling thread: call it from the thread that runs the kernels). softflow's
+    import has chosen numba's fork-safe workqueue layer before this starts its threads.
+    OpenCV's count is left as it is when it is ``threads`` already (inherited, see
+    :func:`opencv_threads`)."""
+    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    if cv2.getNumThreads() != max(1, threads):
+        cv2.setNumThreads(max(1, threads))
+
+
+@contextlib.contextmanager
+def opencv_threads(threads: int):
+    """OpenCV on ``threads`` threads in this process for the block, and in the processes it
+    forks meanwhile. Set it before the fork: a child forked after its parent used OpenCV's
+    thread pool hangs when it resizes the pool it inherited (``cv2.setNumThreads``)."""
+    before = cv2.getNumThreads()
+    cv2.setNumThreads(max(1, threads))
+    try:
+        yield
+    finally:
+        cv2.setNumThreads(before)
 
 
 def capped(fn):

@@ -1,9 +1,11 @@
 """``swtlab process --jobs N`` and ``--dask``, ``process_campaign(client=...)``: the runs are
 computed elsewhere and stored by one writer, and every stored row is the one the serial run
-stores (failed runs included); the CLI's start-up imports no numerical library."""
+stores (failed runs included); each of N workers runs numba, OpenCV and BLAS on its share
+of the cores; the CLI's start-up imports no numerical library."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import sqlite3
 import subprocess
@@ -14,6 +16,8 @@ import pandas as pd
 import pytest
 
 import swtlab
+from swtlab.cores import threads_per_worker
+from swtlab.pipeline.process import ProcessSettings, process_file, worker_pool
 from swtlab_cli.main import COMMANDS, command_module, main
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
@@ -75,6 +79,46 @@ def test_two_worker_processes_store_the_rows_of_the_serial_run(campaign, serial,
     assert rows == serial
     assert _process(campaign, db, "--jobs", "2") == 0   # again: nothing new
     assert "(5 already up to date)" in capsys.readouterr().out and _rows(db) == serial
+
+
+def _threads_after_a_run(path: Path) -> dict:
+    """In a worker: process one run with its soil flow, then the threads it may use."""
+    import cv2
+    import numba
+    from threadpoolctl import threadpool_info
+
+    done = process_file(path, ProcessSettings())
+    return {"flow": done.flow is not None, "failures": done.failures,
+            "numba": numba.get_num_threads(), "opencv": cv2.getNumThreads(),
+            "blas": {i["filepath"]: i["num_threads"] for i in threadpool_info()}}
+
+
+def test_each_of_two_workers_runs_on_its_share_of_the_cores():
+    """On 2 cores each of 2 workers runs 1 numba, OpenCV and BLAS thread (not 2), also
+    after a run with soil flow (numba kernels, OpenCV, libraries loaded by the run); and
+    this process's OpenCV thread pool, used first, does not hang the workers."""
+    share = max(1, len(os.sched_getaffinity(0)) // 2)
+    with_frames = [SAMPLE / "L180_MP0_SC_s+035.mcap", SAMPLE / "L180_MP0_FS"]
+    assert _threads_after_a_run(with_frames[0])["flow"]
+    with worker_pool(2) as pool:
+        seen = list(pool.map(_threads_after_a_run, with_frames))
+    for worker in seen:
+        assert worker["flow"] and worker["failures"] == []
+        assert worker["numba"] == share and worker["opencv"] == share
+        assert len(worker["blas"]) >= 2 and set(worker["blas"].values()) == {share}
+
+
+def test_the_cores_are_split_evenly_and_never_below_one_thread():
+    cores = os.sched_getaffinity(0)
+    assert [threads_per_worker(n) for n in (1, 2, 3)] == [len(cores), len(cores) // 2,
+                                                          max(1, len(cores) // 3)]
+    os.sched_setaffinity(0, {min(cores)})
+    try:
+        assert [threads_per_worker(n) for n in (1, 2)] == [1, 1]
+    finally:
+        os.sched_setaffinity(0, cores)
+    with pytest.raises(ValueError, match="workers 0 must be >= 1"):
+        threads_per_worker(0)
 
 
 def test_a_dask_cluster_of_two_workers_gives_the_serial_results(campaign, serial, tmp_path,

@@ -9,6 +9,7 @@ import dataclasses
 import tomllib
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -137,6 +138,36 @@ def process_file(path: Path, settings: ProcessSettings,
     return done
 
 
+def limit_threads(threads: int) -> None:
+    """Run this process's numba, OpenCV and BLAS/OpenMP on at most ``threads`` threads (each
+    ``jobs`` worker's initializer: N workers each with every core's threads oversubscribe
+    the machine). The libraries a run loads are imported first: threadpoolctl limits only
+    those loaded."""
+    from threadpoolctl import threadpool_limits
+
+    import ingest  # noqa: F401 - loaded before the limits, see above
+    import run_results  # noqa: F401
+    from softflow.threads import limit
+
+    limit(threads)
+    threadpool_limits(limits=threads)
+
+
+@contextmanager
+def worker_pool(workers: int) -> Iterator[ProcessPoolExecutor]:
+    """``workers`` processes, each limited to its share of this process's cores
+    (``swtlab.cores.threads_per_worker``). OpenCV's share is set here too while the pool
+    runs, for the workers forked from this process to inherit (see
+    ``softflow.threads.opencv_threads``)."""
+    from softflow.threads import opencv_threads
+    from swtlab.cores import threads_per_worker
+
+    threads = threads_per_worker(workers)
+    with opencv_threads(threads), ProcessPoolExecutor(
+            workers, initializer=limit_threads, initargs=(threads,)) as pool:
+        yield pool
+
+
 def _process(path: Path, settings: ProcessSettings, content: tuple[str, int] | None,
              keep_samples: bool) -> ProcessedRun:
     done = process_file(path, settings, content)
@@ -150,10 +181,11 @@ def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *
                   client=None, contents: list | None = None,
                   keep_samples: bool = True) -> Iterator[ProcessedRun]:
     """:func:`process_file` of each of ``paths``, yielded in their order as they are done:
-    in this process (``jobs`` 1), on ``jobs`` worker processes, or on the workers of the
-    ``dask.distributed`` ``client``. ``contents``: each file's (sha256, size) or None;
-    ``keep_samples=False`` drops each run's sample tables (``streams``, ``channels``,
-    ``frames``) before it comes back from a worker (results, metadata and problems stay)."""
+    in this process (``jobs`` 1), on ``jobs`` worker processes (:func:`worker_pool`: each
+    on its share of the cores), or on the workers of the ``dask.distributed`` ``client``.
+    ``contents``: each file's (sha256, size) or None; ``keep_samples=False`` drops each
+    run's sample tables (``streams``, ``channels``, ``frames``) before it comes back from a
+    worker (results, metadata and problems stay)."""
     if jobs < 1:
         raise ValueError(f"jobs {jobs} must be >= 1")
     work = list(zip(paths, [settings] * len(paths), contents or [None] * len(paths),
@@ -164,7 +196,7 @@ def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *
             yield future.result()
             future.release()
     elif jobs > 1 and len(work) > 1:
-        with ProcessPoolExecutor(min(jobs, len(work))) as pool:
+        with worker_pool(min(jobs, len(work))) as pool:
             yield from pool.map(_process, *zip(*work))
     else:
         for w in work:
