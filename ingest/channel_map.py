@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -21,7 +21,7 @@ from ingest.errors import IngestError
 FORMATS = ("spec", "delimited")
 _TOP_KEYS = {"map", "files", "time", "channels", "metadata"}
 _CHANNEL_KEYS = {"column", "topic", "field", "unit", "required", "csv_file", "csv_column",
-                 "scale", "offset", "zero", "zero_value"}
+                 "scale", "offset", "zero", "zero_value", "stamp"}
 _FILES_KEYS = {"pattern", "delimiter", "header_rows", "columns", "stream", "comment"}
 
 
@@ -44,6 +44,7 @@ class ChannelSpec:
     offset: float = 0.0
     zero: str | None = None
     zero_value: float = 0.0
+    stamp: str | None = None  # ROS: message path of the time stamp (default header.stamp)
 
     @property
     def csv_name(self) -> str:
@@ -95,6 +96,15 @@ class ChannelMap:
 
     def channels_of(self, topic: str) -> list[ChannelSpec]:
         return [c for c in self.channels if c.topic == topic]
+
+    def stamp_of(self, topic: str) -> str | None:
+        """Message path of the topic's time stamp (None: ``header.stamp``, else log time)."""
+        return next((c.stamp for c in self.channels_of(topic)), None)
+
+    def text_log_map(self) -> "ChannelMap":
+        """A delimited map as it applies to the text log itself: the ``stream``'s channels
+        only (channels on other topics read message paths of a bag)."""
+        return replace(self, channels=tuple(c for c in self.channels if c.topic == self.stream))
 
     @property
     def time_scale_s(self) -> float:
@@ -234,7 +244,8 @@ def _channel(path: Path, raw: Any, fmt: str, stream: str) -> ChannelSpec:
                        csv_column=_text(path, f"{where}.csv_column", raw.get("csv_column")),
                        scale=scale, offset=_number(path, f"{where}.offset", raw.get("offset"), 0.0),
                        zero=zero,
-                       zero_value=_number(path, f"{where}.zero_value", raw.get("zero_value"), 0.0))
+                       zero_value=_number(path, f"{where}.zero_value", raw.get("zero_value"), 0.0),
+                       stamp=_text(path, f"{where}.stamp", raw.get("stamp")))
 
 
 def _filename_fields(path: Path, table: dict) -> tuple[str | None, tuple[FilenameField, ...]]:
@@ -286,10 +297,14 @@ def _parse(path: Path, text: str) -> ChannelMap:
     if not channels:
         raise _fail(path, "channels", "no [[channels]] entries")
     seen: set[str] = set()
+    stamps: dict[str, str | None] = {}
     for c in channels:
         if c.column in seen:
             raise _fail(path, c.column, "fed twice; map each canonical column once")
         seen.add(c.column)
+        if stamps.setdefault(c.topic, c.stamp) != c.stamp:
+            raise _fail(path, c.column, f"stamp differs from another channel of {c.topic}; "
+                        "a topic has one time stamp")
     time = _table(path, "time", doc.get("time", {}))
     _check_keys(path, "time", time, {"column", "unit"})
     time_unit = _unit(path, "time.unit", time.get("unit", "s"), "time")
@@ -309,7 +324,8 @@ def _parse(path: Path, text: str) -> ChannelMap:
     if fmt == "delimited":
         if not columns:
             raise _fail(path, "files.columns", "a delimited map needs the column order")
-        for name in [time_column] + [c.field for c in channels]:
+        # channels on another topic than the stream read message paths of a bag
+        for name in [time_column] + [c.field for c in channels if c.topic == stream]:
             if name not in columns:
                 raise _fail(path, name[:60], f"not one of files.columns ({', '.join(columns)})")
     metadata = dict(_table(path, "metadata", doc.get("metadata", {})))

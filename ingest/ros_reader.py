@@ -3,7 +3,8 @@
 The map's topic is the ROS topic; its field is a path into the message: ``wrench.force.x``
 (WrenchStamped), ``position[0]`` or ``position[wheel_joint]`` (JointState, by index or by
 joint name), ``data`` (Float64), ``data[1]`` (Float64MultiArray), ``point.x`` (PointStamped).
-Time: the message's ``header.stamp`` when it has one, else the bag's log time; counted
+Time: the stamp at the map's ``stamp`` path (``wrench.header.stamp``), else the message's
+``header.stamp`` when it has one, else the bag's log time; counted
 from ``run.started_at`` of the sidecar ``<name>.run.json`` when given, else from the
 earliest time stamp read. Metadata: the sidecar.
 """
@@ -30,58 +31,98 @@ def read_ros(path: Path, cmap: ChannelMap) -> RawRun:
     """The map's topics and message fields of one bag (file or ROS 2 folder)."""
     path = Path(path)
     records = sidecar_records(path)
-    stamps: dict[str, list[int]] = defaultdict(list)
-    values: dict[str, dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
+    samples = _Samples(path, cmap)
     for topic, log_ns, message in _messages(path, set(cmap.topics)):
-        stamps[topic].append(_stamp_ns(message, log_ns))
-        for spec in cmap.channels_of(topic):
-            values[topic][spec.field].append(
-                _field(path, topic, spec.field, message, len(stamps[topic]) - 1))
-    if not stamps:
+        samples.add(topic, log_ns, message)
+    if not samples.stamps:
         return RawRun(path=path, records=records, topics={})
-    start_ns = _start_ns(path, records, stamps)
-    topics = {}
-    for topic, times in stamps.items():
-        t_ns = np.array(times, dtype=np.int64)
-        order = np.argsort(t_ns, kind="stable")
-        topics[topic] = RawTopic(
-            t_s=(t_ns[order] - start_ns) * 1e-9,
-            fields={k: np.asarray(v, dtype=np.float64)[order] for k, v in values[topic].items()})
-    return RawRun(path=path, records=records, topics=topics)
+    return RawRun(path=path, records=records,
+                  topics=samples.raw_topics(_start_ns(path, records, samples.stamps)))
 
 
 def read_ros_rows(path: Path, cmap: ChannelMap) -> RawRun:
     """A delimited map's text log recorded in a bag: each message on the map's ``stream``
     topic carries one row in its ``data`` array (std_msgs/Float64MultiArray), the columns in
-    the map's ``files.columns`` order; time from the map's time column, as for the text."""
+    the map's ``files.columns`` order; time from the map's time column, as for the text.
+    The map's channels on other topics are message paths, as for :func:`read_ros`; their
+    stamps count from the log time of the first row (the row the text's time counts from)."""
     path = Path(path)
-    rows = []
-    for _, _, message in _messages(path, {cmap.stream}):
+    samples = _Samples(path, cmap)
+    rows, first_row_ns = [], None
+    for topic, log_ns, message in _messages(path, set(cmap.topics) | {cmap.stream}):
+        if topic != cmap.stream:
+            samples.add(topic, log_ns, message)
+            continue
         row = np.asarray(getattr(message, "data", ()), dtype=np.float64).reshape(-1)
         if len(row) != len(cmap.columns):
             raise IngestError(path, cmap.stream, f"message {len(rows)} holds {len(row)} values, "
                               f"the channel map {cmap.path.name} expects {len(cmap.columns)} "
                               f"({', '.join(cmap.columns)})")
+        first_row_ns = log_ns if first_row_ns is None else first_row_ns
         rows.append(row)
-    if not rows:
-        return RawRun(path=path, records=sidecar_records(path), topics={})
-    table = np.vstack(rows)
-    wanted = {cmap.time_column} | {c.field for c in cmap.channels}
-    fields = {name: table[:, i] for i, name in enumerate(cmap.columns) if name in wanted}
-    t = fields.pop(cmap.time_column)
-    return RawRun(path=path, records=sidecar_records(path),
-                  topics={cmap.stream: RawTopic(t_s=(t - t[0]) * cmap.time_scale_s,
-                                                fields=fields)})
+    topics = {}
+    if samples.stamps:
+        start_ns = first_row_ns if first_row_ns is not None else \
+            min(min(t) for t in samples.stamps.values())
+        topics = samples.raw_topics(start_ns)
+    if rows:
+        table = np.vstack(rows)
+        wanted = {cmap.time_column} | {c.field for c in cmap.channels_of(cmap.stream)}
+        fields = {name: table[:, i] for i, name in enumerate(cmap.columns) if name in wanted}
+        t = fields.pop(cmap.time_column)
+        topics[cmap.stream] = RawTopic(t_s=(t - t[0]) * cmap.time_scale_s, fields=fields)
+    return RawRun(path=path, records=sidecar_records(path), topics=topics)
+
+
+class _Samples:
+    """Time stamps (ns) and the map's message fields of each topic, in reading order."""
+
+    def __init__(self, path: Path, cmap: ChannelMap):
+        self.path, self.cmap = path, cmap
+        self.stamps: dict[str, list[int]] = defaultdict(list)
+        self.values: dict[str, dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
+
+    def add(self, topic: str, log_ns: int, message) -> None:
+        index = len(self.stamps[topic])
+        self.stamps[topic].append(
+            _stamp_ns(self.path, topic, self.cmap.stamp_of(topic), message, log_ns, index))
+        for spec in dict.fromkeys(c.field for c in self.cmap.channels_of(topic)):
+            value = _walk(self.path, topic, spec, message, index)
+            try:
+                self.values[topic][spec].append(float(value))
+            except (TypeError, ValueError):
+                raise IngestError(self.path, f"{topic}.{spec}", f"message {index}: not a "
+                                  f"number ({type(value).__name__})") from None
+
+    def raw_topics(self, start_ns: int) -> dict[str, RawTopic]:
+        """Each topic in time stamp order, its times in s from ``start_ns``."""
+        topics = {}
+        for topic, times in self.stamps.items():
+            t_ns = np.array(times, dtype=np.int64)
+            order = np.argsort(t_ns, kind="stable")
+            topics[topic] = RawTopic(
+                t_s=(t_ns[order] - start_ns) * 1e-9,
+                fields={k: np.asarray(v, dtype=np.float64)[order]
+                        for k, v in self.values[topic].items()})
+        return topics
 
 
 def _messages(path: Path, topics: set[str]):
     """(topic, log time ns, decoded message) of the bag's messages on ``topics``, in log time
-    order; a damaged bag is one IngestError."""
+    order; a damaged bag or a message type nobody defines is one IngestError."""
     from rosbags.highlevel import AnyReader
 
+    from ingest.ros_types import default_typestore
+
     try:
-        with AnyReader([path]) as reader:
+        with AnyReader([path], default_typestore=default_typestore()) as reader:
             wanted = [c for c in reader.connections if c.topic in topics]
+            for connection in wanted:
+                if connection.msgtype not in reader.typestore.fielddefs:
+                    raise IngestError(path, connection.topic, f"message type "
+                                      f"{connection.msgtype} unknown: the bag carries no "
+                                      "definition of it and it is no ROS 2 standard type nor "
+                                      "one of ingest/ros_msgs (record with definitions)")
             for connection, log_ns, data in reader.messages(connections=wanted):
                 yield connection.topic, log_ns, reader.deserialize(data, connection.msgtype)
     except IngestError:
@@ -94,17 +135,25 @@ def _messages(path: Path, topics: set[str]):
             from None
 
 
-def _stamp_ns(message, log_ns: int) -> int:
-    header = getattr(message, "header", None)
-    stamp = getattr(header, "stamp", None)
-    if stamp is None:
-        return int(log_ns)
-    nsec = getattr(stamp, "nanosec", None)
-    return int(stamp.sec) * 1_000_000_000 + int(stamp.nsec if nsec is None else nsec)
+def _stamp_ns(path: Path, topic: str, stamp: str | None, message, log_ns: int,
+              index: int) -> int:
+    """The message's time stamp in ns: at the map's ``stamp`` path, else ``header.stamp``
+    when the message has one, else the bag's log time."""
+    if stamp is not None:
+        value = _walk(path, topic, stamp, message, index)
+    else:
+        value = getattr(getattr(message, "header", None), "stamp", None)
+        if value is None:
+            return int(log_ns)
+    nsec = getattr(value, "nanosec", getattr(value, "nsec", None))
+    if not hasattr(value, "sec") or nsec is None:
+        raise IngestError(path, f"{topic}.{stamp or 'header.stamp'}", f"message {index}: "
+                          f"not a time stamp ({type(value).__name__}; a stamp has sec and nsec)")
+    return int(value.sec) * 1_000_000_000 + int(nsec)
 
 
-def _field(path: Path, topic: str, spec: str, message, index: int) -> float:
-    """The number at ``spec`` (``wrench.force.x``, ``position[wheel]``) in ``message``."""
+def _walk(path: Path, topic: str, spec: str, message, index: int):
+    """The value at ``spec`` (``wrench.force.x``, ``position[wheel]``) in ``message``."""
     value = message
     for step in spec.split("."):
         match = _STEP.fullmatch(step)
@@ -117,11 +166,7 @@ def _field(path: Path, topic: str, spec: str, message, index: int) -> float:
         key = match.group(2)
         if key is not None:
             value = _item(path, topic, spec, message, value, key, index)
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise IngestError(path, f"{topic}.{spec}", f"message {index}: not a number "
-                          f"({type(value).__name__})") from None
+    return value
 
 
 def _item(path, topic, spec, message, array, key: str, index: int):

@@ -61,6 +61,8 @@ def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = N
     describes."""
     path = Path(path)
     cmap = load_channel_map(channel_map)
+    if cmap.format == "delimited" and not is_ros_bag(path):
+        cmap = cmap.text_log_map()  # a text log has only the stream's channels
     raw = _read_raw(path, cmap)
     for topic, data in raw.topics.items():
         check_topic(path, topic, data)
