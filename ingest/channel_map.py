@@ -1,7 +1,7 @@
 """Channel maps: TOML files that tell ingest a lab's names, columns and units (docs/channel-map.md).
 
 The spec form itself is the shipped map ``spec``; ``cmu_3d_terramechanics`` reads
-the CMU motion logs.
+the CMU motion logs and the rig's bags.
 """
 
 from __future__ import annotations
