@@ -3,6 +3,7 @@ into a ``RawTopic``, and the sidecar ``<name>.run.json`` metadata records."""
 
 from __future__ import annotations
 
+import glob
 from pathlib import Path
 from typing import Any, Callable
 
@@ -11,6 +12,7 @@ import numpy as np
 from ingest.channel_map import ChannelMap
 from ingest.csv_reader import read_run_json
 from ingest.errors import IngestError
+from ingest.formats import BY_SUFFIX, ROS2_METADATA
 from ingest.raw import RawTopic
 
 #: the spec MCAP form's time field: whole ns since the run start (used when the map's
@@ -72,9 +74,32 @@ def raw_topic(path: Path, topic: str, cmap: ChannelMap, t_s: np.ndarray,
 
 
 def sidecar_path(path: Path) -> Path:
-    """``run7.h5`` -> ``run7.run.json`` beside it (a ROS 2 bag folder: ``<folder>.run.json``)."""
+    """The run's sidecar beside it: ``<file name>.run.json`` (``run7.h5`` ->
+    ``run7.h5.run.json``) when there is one, else ``<stem>.run.json`` (``run7.run.json``; a
+    ROS 2 bag folder ``bag7/`` -> ``bag7.run.json``). A stem sidecar that another run file
+    of that stem would read too (``run7.h5`` and ``run7.bag``) is an IngestError."""
     path = Path(path)
-    return path.with_name(path.name.split(".")[0] + ".run.json")
+    own = path.with_name(path.name + ".run.json")
+    shared = path.with_name(path.name.split(".")[0] + ".run.json")
+    if own != shared and own.is_file():
+        return own
+    if shared.is_file():
+        rivals = [p.name for p in _same_stem_runs(path)
+                  if not p.with_name(p.name + ".run.json").is_file()]
+        if rivals:
+            raise IngestError(path, "sidecar", f"{shared.name} is ambiguous: runs {path.name} "
+                              f"and {rivals[0]} share its stem; name each run's sidecar after "
+                              f"its whole file name ({path.name}.run.json)")
+    return shared
+
+
+def _same_stem_runs(path: Path) -> list[Path]:
+    """Other run files or ROS 2 bag folders beside ``path`` with its stem (``run7.*``)."""
+    stem = path.name.split(".")[0]
+    near = [*path.parent.glob(glob.escape(stem) + ".*"), path.parent / stem]
+    return sorted(p for p in near if p != path and (
+        (p.is_file() and p.suffix.lower() in BY_SUFFIX)
+        or (p.is_dir() and (p / ROS2_METADATA).is_file())))
 
 
 def sidecar_records(path: Path) -> dict[str, dict]:

@@ -6,6 +6,7 @@ of a committed sample-campaign MCAP; the reference is ``read_run`` of that MCAP.
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 from pathlib import Path
 
@@ -219,3 +220,19 @@ def test_swtlab_inspect_takes_the_format(fmt, tmp_path, spec_run, capsys):
     path = write(spec_run, tmp_path)
     assert main(["inspect", str(path), *(["--channel-map", cmap] if cmap else [])]) == 0
     assert spec_run.records["run"]["run_id"] in capsys.readouterr().out
+
+
+def test_same_stem_runs_need_their_own_sidecars(tmp_path, spec_run, reference):
+    """run7.h5 and run7.bag in one folder: the stem sidecar run7.run.json would feed both, so
+    it is refused; ``<file name>.run.json`` gives each its own."""
+    h5 = fw.write_hdf5(fw.SpecRun(spec_run.topics, {}), tmp_path / "run7.h5")
+    bag = fw.write_ros1(spec_run, tmp_path / "run7.bag")  # writes run7.run.json
+    for path, cmap in ((h5, None), (bag, "spec_ros")):
+        err = _error(path, cmap)
+        assert err.channel == "sidecar" and "run7.run.json is ambiguous" in err.problem
+    (tmp_path / "run7.run.json").rename(tmp_path / "run7.bag.run.json")
+    records = {**spec_run.records, "run": {**spec_run.records["run"], "load_N": "99.5"}}
+    (tmp_path / "run7.h5.run.json").write_text(json.dumps(records), encoding="utf-8")
+    assert ingest.read_run(h5).metadata.run.load_n == 99.5
+    assert ingest.read_run(bag, "spec_ros").metadata.run.load_n == reference.metadata.run.load_n
+    assert reference.metadata.run.load_n != 99.5
