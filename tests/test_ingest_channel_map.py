@@ -253,6 +253,9 @@ def test_unit_of_the_wrong_quantity(tmp_path):
      "[[channels]]\ncolumn='fz_n'\ntopic='/b'\nfield='g'\nunit='N'\n", "fz_n", "fed twice"),
     ("[time]\nunit='parsec'\n[[channels]]\ncolumn='fz_n'\ntopic='/a'\nfield='f'\nunit='N'\n",
      "time.unit", "unknown unit 'parsec'"),
+    ("[[channels]]\ncolumn='fz_n'\ntopic='/a'\nfield='f'\nunit='N'\nstamp='header.stamp'\n"
+     "[[channels]]\ncolumn='fx_n'\ntopic='/a'\nfield='g'\nunit='N'\n", "fx_n",
+     "stamp differs from another channel of /a"),
 ])
 def test_bad_maps(tmp_path, text, channel, words):
     err = _bad_map(tmp_path, text)
@@ -271,3 +274,20 @@ def test_delimited_file_with_wrong_column_count(tmp_path):
     path.write_text("a\nb\n1;2;3\n")
     with pytest.raises(IngestError, match="3 columns, the channel map bench.toml expects 5"):
         ingest.read_run(path, map_path)
+
+
+def test_delimited_map_channels_on_a_bag_topic_are_message_paths(tmp_path):
+    """A delimited map's channel on another topic than its stream reads a bag's message path:
+    its field need not be a text column, and the text log's map leaves it out (the CMU text
+    logs' problems stay exactly the force columns: tests/test_ingest_cmu.py)."""
+    path = tmp_path / "bag_topic.toml"
+    path.write_text("[map]\nformat='delimited'\n[files]\nstream='/log'\ncolumns=['t','x']\n"
+                    "[time]\ncolumn='t'\n[[channels]]\ncolumn='sled_position_m'\nfield='x'\n"
+                    "unit='m'\nrequired=true\n[[channels]]\ncolumn='fz_n'\ntopic='/ft'\n"
+                    "field='wrench.force.z'\nstamp='header.stamp'\nunit='N'\n")
+    cmap = load_channel_map(path)
+    assert cmap.topics == ["/log", "/ft"] and cmap.stamp_of("/ft") == "header.stamp"
+    assert cmap.stamp_of("/log") is None
+    assert [c.column for c in cmap.text_log_map().channels] == ["sled_position_m"]
+    err = _bad_map(tmp_path, path.read_text().replace("field='x'", "field='y'"))
+    assert err.channel == "y" and "not one of files.columns" in err.problem
