@@ -1,5 +1,5 @@
-"""Message types for ROS bags that carry no definitions of their own (ROS 2 bags recorded
-before Iron): rosbags' ROS 2 Humble standard types plus the lab types shipped as
+"""Message types for ROS bags that carry no definitions of their own (ROS 2 sqlite3 bags
+recorded before Iron): rosbags' ROS 2 Humble standard types plus the lab types shipped as
 ``ingest/ros_msgs/<package>/msg/<Name>.msg`` (``rokubimini_msgs/msg/Reading``, the force/torque
 sensor of the CMU rig). ROS 1 bags and newer ROS 2 bags carry their definitions; rosbags
 decodes those from the bag itself."""
