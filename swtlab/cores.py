@@ -30,7 +30,7 @@ def limit_threads(threads: int) -> None:
     from threadpoolctl import threadpool_limits
 
     import ingest  # noqa: F401 - loaded before the limits, see above
-    import run_results  # noqa: F401
+    import run_results.process  # noqa: F401
     from softflow.threads import limit
 
     limit(threads)
