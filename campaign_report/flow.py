@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
-import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 from sqlalchemy import select
 from sqlalchemy.orm import Session
@@ -24,8 +23,6 @@ from campaign_report.extensions import Extension, register
 from campaign_report.html import Heading, Image, Note, Section, Table
 from campaign_report.images import thumbnail, to_png
 from campaign_report.style import Palette
-from softflow import flow_plots
-from softflow.flow_archive import unpack_flow
 from traceability.models import RawFile, Run, RunResult, SoilFlow, SoilFlowFailure
 
 
@@ -91,6 +88,8 @@ def grouser_scores(grouser: dict) -> Figure:
 
 
 def _image(anchor: str, caption: str, fig) -> Image:
+    import matplotlib.pyplot as plt
+
     png, full = to_png(fig)
     plt.close(fig)
     return Image(anchor, caption, png, thumbnail(full))
@@ -107,6 +106,10 @@ def gather_flows(session: Session, data: CampaignData) -> FlowData | None:
 
 
 def _figures(index: int, run_id: str, row: FlowRecord) -> list[Image]:
+    # here: a campaign without soil flow loads neither softflow nor numba
+    from softflow import flow_plots
+    from softflow.flow_archive import unpack_flow
+
     result, frame = unpack_flow(row.result, row.field_npz)
     anchor = f"flow-{index}"
     images = [

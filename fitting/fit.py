@@ -16,8 +16,7 @@ way), with step and slope by 0.67 % and 0.69 % (docs/fitting.md, "The join at ze
 from __future__ import annotations
 
 import numpy as np
-from scipy.stats import chi2
-from scipy.stats import t as student_t
+from scipy import special
 
 from fitting.curve import DEGREES, QUANTITY_UNITS, CurveFit
 from fitting.degree import (CRITERIA, branch_fits, branch_loo_residuals, candidate_degrees,
@@ -161,6 +160,19 @@ def _branch_se(ls, resid: np.ndarray, weights: np.ndarray, from_se: bool) -> tup
     return float(step_se), float(slope_se)
 
 
+def _chi2_quantile(q: float, dof: int) -> float:
+    """The ``q`` quantile of chi^2 with ``dof`` > 0 degrees of freedom: the function
+    ``scipy.stats.chi2.ppf`` evaluates, without importing scipy.stats (a second of a
+    report's start-up)."""
+    return float(2.0 * special.gammaincinv(dof / 2, q))
+
+
+def _t_quantile(q: float, dof: int) -> float:
+    """The ``q`` quantile of Student's t with ``dof`` > 0 degrees of freedom (what
+    ``scipy.stats.t.ppf`` evaluates)."""
+    return float(special.stdtrit(dof, q))
+
+
 def fit_uncertainty(ls, resid: np.ndarray, weights: np.ndarray, from_se: bool
                     ) -> tuple[tuple[tuple[float, ...], ...], float, float]:
     """(covariance of ``(a_0 ... a_n, J, K)``, run-to-run SD, 95 % factor) of a fit
@@ -173,12 +185,12 @@ def fit_uncertainty(ls, resid: np.ndarray, weights: np.ndarray, from_se: bool
     wrss = float(np.sum(weights * resid ** 2))
     ratio = wrss / dof if dof > 0 else float("nan")
     if from_se:
-        trusted = not dof > 0 or wrss <= float(chi2.ppf(0.95, dof))
+        trusted = not dof > 0 or wrss <= _chi2_quantile(0.95, dof)
         scale = 1.0 if trusted else ratio
         scatter = float(np.sqrt(scale * np.mean(1.0 / weights)))
     else:
         trusted, scale = False, ratio
         scatter = float(np.sqrt(ratio))
-    k95 = Z95 if trusted else float(student_t.ppf(0.975, dof)) if dof > 0 else float("nan")
+    k95 = Z95 if trusted else _t_quantile(0.975, dof) if dof > 0 else float("nan")
     covariance = ls.covariance * scale
     return tuple(tuple(float(v) for v in row) for row in covariance), scatter, k95

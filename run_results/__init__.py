@@ -5,14 +5,23 @@ Pure functions: ``process_run(run) -> RunResult``;
 reads ground truth.
 """
 
-from run_results.corrections import RigCompliance, corrected_heights, tare_record
-from run_results.modes import results_table, towed_vs_powered
-from run_results.oscillation import harmonic_fit, measure_frequency_hz
-from run_results.phase_average import phase_average
-from run_results.process import process_run
-from run_results.result import RunResult
-from run_results.stats import QuantityStats, quantity_stats
+from importlib import import_module
 
-__all__ = ["QuantityStats", "RigCompliance", "RunResult", "corrected_heights", "harmonic_fit",
-           "measure_frequency_hz", "phase_average", "process_run", "quantity_stats",
-           "results_table", "tare_record", "towed_vs_powered"]
+#: public name -> the module defining it; imported on first use (PEP 562), so that reading
+#: stored results (``run_results.result``, ``run_results.traces``) does not load the readers
+_SOURCES = {"RigCompliance": "corrections", "corrected_heights": "corrections",
+            "tare_record": "corrections", "results_table": "modes",
+            "towed_vs_powered": "modes", "harmonic_fit": "oscillation",
+            "measure_frequency_hz": "oscillation", "phase_average": "phase_average",
+            "process_run": "process", "RunResult": "result", "QuantityStats": "stats",
+            "quantity_stats": "stats"}
+
+__all__ = sorted(_SOURCES)
+
+
+def __getattr__(name: str):
+    if name not in _SOURCES:
+        raise AttributeError(f"module 'run_results' has no attribute {name!r}")
+    value = getattr(import_module(f"run_results.{_SOURCES[name]}"), name)
+    globals()[name] = value
+    return value

@@ -16,7 +16,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import stats
 
 from softflow.decay_fit import DecayFit
 
@@ -25,6 +24,8 @@ MIN_R2 = 0.5  # k fits below this are not used (as for the grouser models)
 
 def rates_and_sigmas(fits: Sequence[DecayFit | None]) -> tuple[np.ndarray, np.ndarray]:
     """``k`` and its standard error (from the 95 % CI) per bin; NaN where unusable."""
+    from scipy import stats  # here: reading a stored flow does not need scipy.stats
+
     k = np.full(len(fits), np.nan)
     sigma = np.full(len(fits), np.nan)
     for i, f in enumerate(fits):
@@ -38,6 +39,8 @@ def rates_and_sigmas(fits: Sequence[DecayFit | None]) -> tuple[np.ndarray, np.nd
 def fit_alpha12(eps: np.ndarray, k_per_m: np.ndarray, k_sigma_per_m: np.ndarray) -> dict | None:
     """``alpha1_per_m``, ``alpha2``, ``bins_used``, their 95 % CIs and ``eps_range``; None
     with fewer than 3 usable pairs."""
+    from scipy import stats
+
     eps, k, sk = (np.asarray(a, np.float64) for a in (eps, k_per_m, k_sigma_per_m))
     ok = np.isfinite(eps) & np.isfinite(k) & np.isfinite(sk) & (k > 0)
     n = int(ok.sum())

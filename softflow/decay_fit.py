@@ -12,7 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 from scipy.optimize import curve_fit
 
 
@@ -35,6 +34,8 @@ def _model(rho, a, k):
 
 def fit_decay(rho_m: np.ndarray, value: np.ndarray, sigma: np.ndarray) -> DecayFit | None:
     """Fit one profile; ``None`` with fewer than 5 points or no convergence."""
+    from scipy import stats  # here: reading a stored flow does not need scipy.stats
+
     if len(rho_m) < 5:
         return None
     a0 = value[np.argmin(rho_m)]

@@ -131,11 +131,13 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
                    grouser_height_px: float | None = None, engine: str = "deform-lk",
                    eps_vol_by_beta: np.ndarray | None = None,
                    frame_range: tuple[int, int] | None = None, source: str = "",
-                   eps_depth_m: float | None = None) -> FlowResult:
+                   eps_depth_m: float | None = None, client=None) -> FlowResult:
     """Run the whole SOFT analysis on grey frames of the stable phase (2 or more).
 
     Without ``eps_vol_by_beta`` (per beta bin), ``eps_vol^P`` is estimated below the
     axle at ``eps_depth_m`` (default a fifth of the rim radius) outside the wheel.
+    ``client``: a ``dask.distributed.Client`` whose workers compute the frame pairs' flows
+    (the rest runs here; the same result).
     """
     if len(frames) < 2:
         raise ValueError("need at least two frames")
@@ -147,7 +149,7 @@ def analyse_frames(frames: list[np.ndarray], t_s: np.ndarray, px_per_m: float,
                            ).astype(bool)
     masks = [soil_mask(frames[0].shape, poses[k]) & soil_mask(frames[0].shape, poses[k + 1])
              & textured for k in range(len(frames) - 1)]
-    mean = average_flow(frames, np.asarray(t_s, float), masks, engine)
+    mean = average_flow(frames, np.asarray(t_s, float), masks, engine, client=client)
     center = tuple(np.mean([p.center_px for p in poses], axis=0))
     r_px, beta, theta = polar_coordinates(frames[0].shape, center, direction)
     v_cam = mean.velocity_px_per_s / px_per_m

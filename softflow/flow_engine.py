@@ -295,9 +295,26 @@ class MeanField:
     pair_velocities_px_per_s: list[np.ndarray]  # per pair, NaN where masked or rejected
 
 
+def _pair_flows(frames: list[np.ndarray], soil_masks: list[np.ndarray], engine: str,
+                client=None):
+    """:func:`pair_displacement_px` of each consecutive pair (fixed window
+    ``RATE_KERNELS_PX``) in pair order: here, or on the workers of the ``dask.distributed``
+    ``client`` (each frame sent once; ``swtlab.cluster.map_in_order``)."""
+    n = len(frames) - 1
+    if client is None:
+        return (pair_displacement_px(frames[k], frames[k + 1], engine, soil_masks[k],
+                                     RATE_KERNELS_PX) for k in range(n))
+    from swtlab.cluster import map_in_order
+
+    sent = client.scatter(list(frames))
+    return map_in_order(client, pair_displacement_px, sent[:-1], sent[1:], [engine] * n,
+                        client.scatter(list(soil_masks[:n])), [RATE_KERNELS_PX] * n)
+
+
 def average_flow(frames: list[np.ndarray], t_s: np.ndarray, soil_masks: list[np.ndarray],
-                 engine: str = "deform-lk", keep_pairs: bool = True) -> MeanField:
-    """Flow of each consecutive pair, median-tested, divided by its own dt, averaged.
+                 engine: str = "deform-lk", keep_pairs: bool = True, client=None) -> MeanField:
+    """Flow of each consecutive pair, median-tested, divided by its own dt, averaged; the
+    pairs' flows computed on the workers of ``client`` when given (the same numbers).
 
     ``soil_masks[k]`` (bool, H x W): pixels of pair ``k`` that are soil in both frames.
     The flow is measured with the small fixed window ``RATE_KERNELS_PX``, not the adaptive
@@ -310,11 +327,9 @@ def average_flow(frames: list[np.ndarray], t_s: np.ndarray, soil_masks: list[np.
     count = np.zeros(frames[0].shape, np.int32)
     flagged = used = 0
     pairs = []
-    for k in range(len(frames) - 1):
+    for k, flow in enumerate(_pair_flows(frames, soil_masks, engine, client)):
         dt = float(t_s[k + 1] - t_s[k])
         valid = soil_masks[k]
-        flow = pair_displacement_px(frames[k], frames[k + 1], engine, soil=valid,
-                                    windows=RATE_KERNELS_PX)
         bad = normalised_median_outliers(flow, valid)
         good = valid & ~bad
         flagged += int(bad.sum())

@@ -40,7 +40,7 @@ so not in the scatter: ``FLOW_FIELD_ERROR`` (measured on renders, docs/softflow.
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage, stats
+from scipy import ndimage
 
 SIGMA_PX = 5.0  # derivative scale: smallest eps error on renders (docs/softflow.md)
 UNDISTURBED = 0.01  # |u + V| / |V| where a streamline may end
@@ -176,6 +176,8 @@ def strain_by_beta(velocity_px_per_s: np.ndarray, center_px: tuple[float, float]
 
     ``velocity_px_per_s``: mean camera-frame field (H, W, 2), NaN where masked.
     """
+    from scipy import stats  # here: reading a stored flow does not need scipy.stats
+
     args = (velocity_px_per_s, center_px, radius_px, beta_centres, width_rad,
             far_velocity_px_per_s)
     samples, left = _bin_samples(*args, sigma_px)

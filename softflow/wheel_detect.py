@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import stats
 
 N_RAYS = 720
 MASK_MARGIN_PX = 8.0  # soil kept this far from the grouser tips (texture window, blur)
@@ -309,6 +308,8 @@ def track_wheel(frames: list[np.ndarray], direction: int = 1,
     through the frames (the wheel turns steadily in the stable phase; one frame's
     bad phase does not count).
     """
+    from scipy import stats  # here: reading a stored pose does not need scipy.stats
+
     poses = []
     for gray in frames:
         try:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy import stats
 
 from stable_phase.autocorr import statistical_inefficiency
 
@@ -12,6 +11,8 @@ def slope_test(t_s: np.ndarray, y: np.ndarray) -> dict:
     """OLS trend of ``y`` over the window, its SE inflated by the residuals' statistical
     inefficiency (autocorrelated residuals), a two-sided p value and the change over the window.
     """
+    from scipy import stats  # here: a report reading stored results does not need it
+
     ok = np.isfinite(y)
     t, y = t_s[ok], y[ok]
     if t.size < 8:

@@ -38,6 +38,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float, help="frame rate, when the frames carry no times")
     p.add_argument("--engine", choices=ENGINE_CHOICES, default=ENGINE_CHOICES[0],
                    help="optical-flow engine (default deform-lk, see docs/softflow.md)")
+    p.add_argument("--dask", metavar="SCHEDULER_ADDRESS",
+                   help="compute the frame pairs' flows on this dask.distributed scheduler's "
+                        "workers (e.g. tcp://10.0.0.5:8786; docs/scale-out.md)")
     p.set_defaults(func=run)
 
 
@@ -46,18 +49,28 @@ def run(args: argparse.Namespace) -> int:
     from softflow.flow_checks import FlowMeasurementError
     from softflow.frames import FrameSourceError, load_frames
     from softflow.wheel_detect import WheelNotFoundError
+    from swtlab.cluster import connect
 
+    try:
+        client = connect(args.dask) if args.dask else None
+    except ValueError as exc:
+        print(f"swtlab flow: {exc}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
     try:
         fs = load_frames(args.source, args.frames, args.px_per_m, args.fps)
         result = analyse_frames(fs.frames, fs.t_s, fs.px_per_m, fs.direction, fs.wheel_center_px,
                                 fs.wheel_radius_px, fs.grouser_count, fs.grouser_height_px,
-                                args.engine, frame_range=fs.frame_range, source=fs.source)
+                                args.engine, frame_range=fs.frame_range, source=fs.source,
+                                client=client)
     except (FrameSourceError, WheelNotFoundError, OSError) as exc:
         print(f"swtlab flow: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     except FlowMeasurementError as exc:
         print(f"swtlab flow: {fs.source}: soil flow not measured: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
+    finally:
+        if client is not None:
+            client.close()
     data = result.to_dict()
     if args.json == "-":
         print(json.dumps(data, indent=2))

@@ -23,7 +23,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--workdir", type=Path, help="keep campaigns, reports and labels here "
                                                 "(default: a temporary folder)")
-    p.add_argument("--jobs", type=int, default=2, help="campaigns diagnosed at a time")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--jobs", type=int, default=2, help="campaigns diagnosed at a time")
+    where.add_argument("--dask", metavar="SCHEDULER_ADDRESS",
+                       help="make and diagnose the campaigns on this dask.distributed "
+                            "scheduler's workers, one task each (they must see --workdir at "
+                            "the same path; docs/scale-out.md)")
     p.add_argument("--boot", type=int, default=50, help="bootstrap replicates per diagnosis")
     p.add_argument("--fast", action="store_true",
                    help="small campaigns (2 loads x 3 slips x 2 multipass x 2 gravity)")
@@ -44,6 +49,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from swtlab.cluster import connect
     from validation.gap_bench import FAST_DESIGN, Design, format_score, run_bench
 
     if args.n < 1:
@@ -52,12 +58,17 @@ def run(args: argparse.Namespace) -> int:
     design = replace(FAST_DESIGN if args.fast else Design(), smooth_wheel=args.smooth_wheel)
     with tempfile.TemporaryDirectory(prefix="gap-bench-") as tmp:
         workdir = args.workdir or Path(tmp)
+        client = None
         try:
+            client = connect(args.dask) if args.dask else None
             result = run_bench(args.n, args.seed, workdir, design, args.jobs, args.boot,
-                               args.truth_laws, args.signal_model)
+                               args.truth_laws, args.signal_model, client)
         except ValueError as exc:
             print(f"swtlab gap-bench: {exc}")
             return exit_codes.BAD_INPUT
+        finally:
+            if client is not None:
+                client.close()
     print(format_score(result))
     t = result["timing_s"]
     print(f"time: generate {t['generate']:.0f} s, process + diagnose "

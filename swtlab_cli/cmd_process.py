@@ -34,10 +34,6 @@ from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
 from swtlab_cli.progress import progress
 
-#: how long ``--dask`` waits for its scheduler
-CONNECT_TIMEOUT_S = 20
-
-
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser(
         "process", help="ingest and process every run of a campaign into the database",
@@ -83,23 +79,10 @@ def _jobs(text: str) -> int:
     return jobs
 
 
-def _client(address: str):
-    """A dask.distributed client of the scheduler at ``address``; a one-line error when
-    dask is not installed or the scheduler cannot be reached."""
-    try:
-        from distributed import Client
-    except ImportError:
-        raise ValueError("--dask needs dask.distributed (pip install 'dask[distributed]')"
-                         ) from None
-    try:
-        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
-    except (OSError, TimeoutError, ValueError) as error:
-        raise ValueError(f"--dask {address}: cannot reach the scheduler ({error})") from None
-
-
 def run(args: argparse.Namespace) -> int:
     import ingest
     from swtlab.pipeline.database import store_one
+    from swtlab.cluster import connect
     from swtlab.cores import available_cores
     from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
                                          process_files, rig_compliance)
@@ -116,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
         settings = ProcessSettings(channel_map=args.channel_map,
                                    rig=rig_compliance(args.campaign, args.rig_compliance),
                                    budget=budget_params(args.campaign))
-        client = _client(args.dask) if args.dask else None
+        client = connect(args.dask) if args.dask else None
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
         print(f"swtlab process: {error}", file=sys.stderr)
         return exit_codes.BAD_INPUT

@@ -287,3 +287,14 @@ def test_one_braked_run_cannot_carry_a_branch():
         fit_curve(slip, _stepped(slip), degree=3, branch=1)
     with pytest.raises(FittingError, match="branch 'yes': give 'auto', 0, 1 or 2"):
         fit_curve(slip, _stepped(slip), degree=3, branch="yes")
+
+
+@pytest.mark.parametrize("dof, t975, chi2_95", [(1, 12.706, 3.841), (5, 2.571, 11.070),
+                                                (10, 2.228, 18.307), (30, 2.042, 43.773)])
+def test_the_band_quantiles_are_the_tabulated_ones(dof, t975, chi2_95):
+    """Student's t 0.975 and chi^2 0.95 quantiles against the printed tables (NIST/SEMATECH
+    e-Handbook of Statistical Methods, 2012, sections 1.3.6.7.2 and 1.3.6.7.4; 3 decimals)."""
+    from fitting.fit import _chi2_quantile, _t_quantile
+
+    assert _t_quantile(0.975, dof) == pytest.approx(t975, abs=5e-4)
+    assert _chi2_quantile(0.95, dof) == pytest.approx(chi2_95, abs=5e-4)

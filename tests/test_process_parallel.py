@@ -144,9 +144,9 @@ def test_a_dask_cluster_of_two_workers_gives_the_serial_results(campaign, serial
 def test_an_unreachable_scheduler_is_one_line_and_exit_3(campaign, tmp_path, capsys,
                                                          monkeypatch):
     pytest.importorskip("distributed")
-    from swtlab_cli import cmd_process
+    from swtlab import cluster
 
-    monkeypatch.setattr(cmd_process, "CONNECT_TIMEOUT_S", 1)
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 1)
     code = _process(campaign, tmp_path / "db.sqlite", "--dask", "tcp://127.0.0.1:9")
     err = capsys.readouterr().err.strip()
     assert code == 3 and err.startswith("swtlab process: --dask tcp://127.0.0.1:9: cannot reach")

@@ -193,9 +193,10 @@ def laws_option(laws: dict[str, tuple[str, ...]] | None) -> str:
 
 def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
                    workers: int = 2, truth_laws: str = "in-family",
-                   signal_model: str = "testbed") -> Path:
-    """Write ``n`` campaigns, the laws each diagnosis may use and the labels file; return
-    the labels path."""
+                   signal_model: str = "testbed", client=None) -> Path:
+    """Write ``n`` campaigns (``workers`` at a time, or on the workers of the
+    ``dask.distributed`` ``client``), the laws each diagnosis may use and the labels file;
+    return the labels path."""
     if signal_model not in SIGNAL_MODELS:
         raise ValueError(f"signal_model must be one of {SIGNAL_MODELS}, not {signal_model!r}")
     workdir.mkdir(parents=True, exist_ok=True)
@@ -204,8 +205,13 @@ def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
     truths = [draw_truth(rng, i) for i in range(n)]
     jobs = [(workdir, f"c{i:03d}", truth, seed * 1000 + i, design, signal_model)
             for i, (truth, _) in enumerate(truths)]
-    with ProcessPoolExecutor(workers) as pool:
-        list(pool.map(_generate, jobs))
+    if client is not None:
+        from swtlab.cluster import map_in_order
+
+        list(map_in_order(client, _generate, jobs))
+    else:
+        with ProcessPoolExecutor(workers) as pool:
+            list(pool.map(_generate, jobs))
     for i in range(n):
         write_atomically(workdir / f"c{i:03d}" / "laws.txt",
                          laws_option(diagnosis_laws(i, truth_laws)) + "\n")
@@ -216,10 +222,12 @@ def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
     return path
 
 
-def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True) -> float:
-    """``swtlab process`` (unless ``process`` is False: the database is there) then
-    ``swtlab gap`` in separate processes that are given the raw campaign folder, the
-    database, the simulation and the laws they may use only. Returns the seconds taken."""
+def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True,
+                      jobs: int | None = None) -> float:
+    """``swtlab process`` (unless ``process`` is False: the database is there; ``--jobs
+    jobs`` when given) then ``swtlab gap`` in separate processes that are given the raw
+    campaign folder, the database, the simulation and the laws they may use only. Returns
+    the seconds taken."""
     start = time.perf_counter()
     dbs = [(workdir / name / "campaign", f"sqlite:///{workdir / name / 'swtlab.sqlite'}")]
     if (workdir / name / "smooth" / "campaign").is_dir():
@@ -228,7 +236,8 @@ def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True)
     cli = [sys.executable, "-m", "swtlab_cli.main"]
     if process:
         for folder, db in dbs:
-            subprocess.run(cli + ["process", str(folder), "--db", db, "--quiet"], check=True,
+            subprocess.run(cli + ["process", str(folder), "--db", db, "--quiet"]
+                           + (["--jobs", str(jobs)] if jobs else []), check=True,
                            capture_output=True)
     laws = (workdir / name / "laws.txt").read_text().strip()
     measured = [arg for _, db in dbs for arg in ("--measured", db)]
@@ -319,33 +328,46 @@ def format_score(s: dict) -> str:
 
 
 def run_bench(n: int, seed: int, workdir: Path, design: Design = Design(), jobs: int = 2,
-              boot: int = 50, truth_laws: str = "in-family", signal_model: str = "testbed"
-              ) -> dict:
-    """Generate, diagnose (``jobs`` campaigns at a time, each in its own processes), score."""
+              boot: int = 50, truth_laws: str = "in-family", signal_model: str = "testbed",
+              client=None) -> dict:
+    """Generate, diagnose (``jobs`` campaigns at a time, each in its own processes; or one
+    task per campaign on the workers of the ``dask.distributed`` ``client``, which must see
+    ``workdir`` at the same path), score."""
     t0 = time.perf_counter()
-    labels = make_campaigns(n, seed, workdir, design, jobs, truth_laws, signal_model)
+    labels = make_campaigns(n, seed, workdir, design, jobs, truth_laws, signal_model, client)
     t1 = time.perf_counter()
-    return _diagnose_and_score(labels, workdir, n, jobs, boot, True, truth_laws, t1 - t0)
+    return _diagnose_and_score(labels, workdir, n, jobs, boot, True, truth_laws, t1 - t0,
+                               client)
 
 
-def rediagnose(workdir: Path, truth_laws: str, jobs: int = 2, boot: int = 50) -> dict:
+def rediagnose(workdir: Path, truth_laws: str, jobs: int = 2, boot: int = 50,
+               client=None) -> dict:
     """Diagnose the processed campaigns of ``workdir`` again under the other ``truth_laws``
-    mode (same raw data, same truths: only the laws given to the diagnosis change), score."""
+    mode (same raw data, same truths: only the laws given to the diagnosis change), score;
+    ``jobs``, ``client``: as in :func:`run_bench`."""
     labels = workdir / "labels" / "labels.json"
     n = len(json.loads(labels.read_text()))
     for i in range(n):
         write_atomically(workdir / f"c{i:03d}" / "laws.txt",
                          laws_option(diagnosis_laws(i, truth_laws)) + "\n")
-    return _diagnose_and_score(labels, workdir, n, jobs, boot, False, truth_laws, 0.0)
+    return _diagnose_and_score(labels, workdir, n, jobs, boot, False, truth_laws, 0.0, client)
 
 
 def _diagnose_and_score(labels: Path, workdir: Path, n: int, jobs: int, boot: int,
-                        process: bool, truth_laws: str, generate_s: float) -> dict:
+                        process: bool, truth_laws: str, generate_s: float,
+                        client=None) -> dict:
     t1 = time.perf_counter()
     names = [f"c{i:03d}" for i in range(n)]
-    with ThreadPoolExecutor(jobs) as pool:
-        seconds = list(pool.map(lambda name: diagnose_campaign(workdir, name, boot, process),
-                                names))
+    if client is not None:  # one task, one core per campaign: its runs in one process
+        from swtlab.cluster import map_in_order, task_slots
+
+        jobs = sum(task_slots(client).values())
+        seconds = list(map_in_order(client, diagnose_campaign, [workdir] * n, names,
+                                    [boot] * n, [process] * n, [1] * n))
+    else:
+        with ThreadPoolExecutor(jobs) as pool:
+            seconds = list(pool.map(lambda name: diagnose_campaign(workdir, name, boot,
+                                                                   process), names))
     t2 = time.perf_counter()
     out = {**score(labels, workdir), "truth_laws": truth_laws}
     out["timing_s"] = {"generate": generate_s, "process_and_diagnose": t2 - t1,

@@ -138,21 +138,6 @@ def process_file(path: Path, settings: ProcessSettings,
     return done
 
 
-def limit_threads(threads: int) -> None:
-    """Run this process's numba, OpenCV and BLAS/OpenMP on at most ``threads`` threads (each
-    ``jobs`` worker's initializer: N workers each with every core's threads oversubscribe
-    the machine). The libraries a run loads are imported first: threadpoolctl limits only
-    those loaded."""
-    from threadpoolctl import threadpool_limits
-
-    import ingest  # noqa: F401 - loaded before the limits, see above
-    import run_results  # noqa: F401
-    from softflow.threads import limit
-
-    limit(threads)
-    threadpool_limits(limits=threads)
-
-
 @contextmanager
 def worker_pool(workers: int) -> Iterator[ProcessPoolExecutor]:
     """``workers`` processes, each limited to its share of this process's cores
@@ -160,7 +145,7 @@ def worker_pool(workers: int) -> Iterator[ProcessPoolExecutor]:
     runs, for the workers forked from this process to inherit (see
     ``softflow.threads.opencv_threads``)."""
     from softflow.threads import opencv_threads
-    from swtlab.cores import threads_per_worker
+    from swtlab.cores import limit_threads, threads_per_worker
 
     threads = threads_per_worker(workers)
     with opencv_threads(threads), ProcessPoolExecutor(
@@ -182,7 +167,8 @@ def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *
                   keep_samples: bool = True) -> Iterator[ProcessedRun]:
     """:func:`process_file` of each of ``paths``, yielded in their order as they are done:
     in this process (``jobs`` 1), on ``jobs`` worker processes (:func:`worker_pool`: each
-    on its share of the cores), or on the workers of the ``dask.distributed`` ``client``.
+    on its share of the cores), or on the workers of the ``dask.distributed`` ``client``
+    (``swtlab.cluster.map_in_order``: each on its share of its host's cores).
     ``contents``: each file's (sha256, size) or None; ``keep_samples=False`` drops each
     run's sample tables (``streams``, ``channels``, ``frames``) before it comes back from a
     worker (results, metadata and problems stay)."""
@@ -191,10 +177,9 @@ def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *
     work = list(zip(paths, [settings] * len(paths), contents or [None] * len(paths),
                     [keep_samples] * len(paths)))
     if client is not None:
-        futures = client.map(_process, *zip(*work), pure=False)
-        for future in futures:
-            yield future.result()
-            future.release()
+        from swtlab.cluster import map_in_order
+
+        yield from map_in_order(client, _process, *zip(*work))
     elif jobs > 1 and len(work) > 1:
         with worker_pool(min(jobs, len(work))) as pool:
             yield from pool.map(_process, *zip(*work))

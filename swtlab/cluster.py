@@ -1,0 +1,74 @@
+"""Work on a dask.distributed cluster (docs/scale-out.md): :func:`connect` to a scheduler,
+:func:`map_in_order` to run one function over many inputs on its workers, results back in
+the order of the inputs. ``swtlab process`` (runs), ``swtlab flow`` (frame pairs) and
+``swtlab gap-bench`` (campaigns) all use these.
+
+Each task runs numba, OpenCV and BLAS/OpenMP on its share of its host's cores: the cores
+the worker may run on split evenly over the task threads (``nthreads``) of all workers on
+that host, at least one (:func:`worker_threads`); left alone, every worker would start a
+thread per core.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+#: how long :func:`connect` waits for its scheduler
+CONNECT_TIMEOUT_S = 20
+
+
+def connect(address: str):
+    """A ``dask.distributed.Client`` of the scheduler at ``address``; a one-line
+    ``ValueError`` when dask is not installed or the scheduler cannot be reached."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ValueError("--dask needs dask.distributed (pip install 'dask[distributed]')"
+                         ) from None
+    try:
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+    except (OSError, TimeoutError, ValueError) as error:
+        raise ValueError(f"--dask {address}: cannot reach the scheduler ({error})") from None
+
+
+def task_slots(client) -> dict[str, int]:
+    """Task threads (``nthreads``) of the client's workers, summed per host."""
+    slots: dict[str, int] = {}
+    for worker in client.scheduler_info()["workers"].values():
+        slots[worker["host"]] = slots.get(worker["host"], 0) + worker["nthreads"]
+    return slots
+
+
+def worker_threads(slots: dict[str, int]) -> int:
+    """In a dask worker: the threads each of its tasks may run, ``available_cores() //``
+    the task threads on its host (``slots``, :func:`task_slots`; a worker that joined
+    since: its own), at least one."""
+    from distributed import get_worker
+
+    from swtlab.cores import available_cores
+
+    worker = get_worker()
+    return max(1, available_cores() // max(1, slots.get(worker.ip, worker.state.nthreads)))
+
+
+def _capped(fn, slots: dict[str, int], *args):
+    from swtlab.cores import limit_threads
+
+    limit_threads(worker_threads(slots))
+    return fn(*args)
+
+
+def map_in_order(client, fn, *iterables) -> Iterator:
+    """``fn(*args)`` for each ``args`` of ``zip(*iterables)``, on the workers of ``client``
+    (each task on its share of its host's cores), yielded in input order as they are done;
+    an error raised by ``fn`` is raised here. Arguments may be the client's futures
+    (``client.scatter``: data sent once, used by several tasks)."""
+    work = list(zip(*iterables))
+    if not work:
+        return
+    slots = task_slots(client)
+    futures = client.map(_capped, [fn] * len(work), [slots] * len(work), *zip(*work),
+                         pure=False)
+    for future in futures:
+        yield future.result()
+        future.release()

@@ -1,0 +1,122 @@
+"""swtlab.cluster on a real two-worker ``dask.distributed.LocalCluster``: each task runs
+numba, OpenCV and BLAS on its share of its host's cores; ``swtlab flow --dask`` (frame
+pairs) and the gap-bench's campaigns on the cluster give the numbers of the local run."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from softflow.field_analysis import analyse_frames
+from swtlab.cluster import map_in_order, task_slots
+from swtlab_cli.main import main
+from swtlab.domain.gravity import G0_MPS2
+from validation.gap_bench import Design, run_bench
+from virtual_testbed.flow_render import FlowScene, render_flow, write_flow_render
+
+distributed = pytest.importorskip("distributed")
+
+
+@pytest.fixture(scope="module")
+def client():
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            yield client
+
+
+def _limits(_) -> dict:
+    """In a task: the threads numba, OpenCV and each loaded BLAS/OpenMP library may use."""
+    import cv2
+    import numba
+    from threadpoolctl import threadpool_info
+
+    return {"numba": numba.get_num_threads(), "opencv": cv2.getNumThreads(),
+            "blas": {i["filepath"]: i["num_threads"] for i in threadpool_info()}}
+
+
+def test_each_task_runs_on_its_share_of_its_hosts_cores(client):
+    """2 one-thread workers on this host: each task gets cores // 2 threads (1 on 2 cores),
+    not the thread per core each library starts with."""
+    share = max(1, len(os.sched_getaffinity(0)) // 2)
+    assert task_slots(client) == {"127.0.0.1": 2}
+    seen = list(map_in_order(client, _limits, range(4)))
+    assert len(seen) == 4
+    for limits in seen:
+        assert limits["numba"] == share and limits["opencv"] == share
+        assert len(limits["blas"]) >= 2 and set(limits["blas"].values()) == {share}
+
+
+def _fails(x):
+    if x == 2:
+        raise ValueError(f"task {x} failed")
+    return x
+
+
+def test_results_come_back_in_input_order_and_errors_are_raised(client):
+    assert list(map_in_order(client, _fails, [1, 0, 3])) == [1, 0, 3]
+    with pytest.raises(ValueError, match="task 2 failed"):
+        list(map_in_order(client, _fails, [1, 2]))
+    assert list(map_in_order(client, _fails, [])) == []
+
+
+@pytest.fixture(scope="module")
+def render():
+    scene = FlowScene(seed=5)
+    return scene, render_flow(scene, 3)  # 3 frames: 2 pairs
+
+
+def test_frame_pairs_on_the_cluster_give_the_local_flow(client, render, tmp_path):
+    scene, r = render
+    here = analyse_frames(r.frames, r.t_s, scene.px_per_m)
+    there = analyse_frames(r.frames, r.t_s, scene.px_per_m, client=client)
+    assert here.mean.count.max() == 2 and np.isfinite(here.mean.velocity_px_per_s).any()
+    np.testing.assert_array_equal(there.mean.velocity_px_per_s, here.mean.velocity_px_per_s)
+    for a, b in zip(there.mean.pair_velocities_px_per_s, here.mean.pair_velocities_px_per_s):
+        np.testing.assert_array_equal(a, b)
+    write_flow_render(r, tmp_path / "run")
+    address = client.scheduler.address
+    for name, options in (("here", []), ("there", ["--dask", address])):
+        assert main(["flow", str(tmp_path / "run"), "--json", str(tmp_path / name)]
+                    + options) == 0
+    assert json.loads((tmp_path / "here").read_text())["pairs"] == 2
+    assert (tmp_path / "there").read_text() == (tmp_path / "here").read_text()
+
+
+def test_flow_with_an_unreachable_scheduler_is_one_line_and_exit_3(render, tmp_path, capsys,
+                                                                    monkeypatch):
+    from swtlab import cluster
+
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 1)
+    assert main(["flow", str(tmp_path), "--dask", "tcp://127.0.0.1:9"]) == 3
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("swtlab flow: --dask tcp://127.0.0.1:9: cannot reach")
+    assert len(err.splitlines()) == 1
+
+
+def _files(folder) -> dict:
+    """Every file under ``folder`` (relative path: bytes, ``folder`` itself named WORK), the
+    databases and the scores (they hold when each was made) left out."""
+    return {str(p.relative_to(folder)): p.read_bytes().replace(str(folder).encode(), b"WORK")
+            for p in sorted(folder.rglob("*"))
+            if p.is_file() and p.suffix != ".sqlite" and not p.name.startswith("score-")}
+
+
+def test_a_gap_bench_campaign_on_the_cluster_is_the_local_one(client, tmp_path):
+    """One tiny campaign (8 runs; held-out laws: one law per family, the fastest diagnosis)
+    made, processed and diagnosed in tasks on the cluster: every file (raw runs, truth,
+    labels, laws, the gap report) and the score are the local run's."""
+    design = Design(loads_n=(80.0, 250.0), slips=(0.15, 0.65), gravity_mps2=(G0_MPS2,))
+    runs = {"seed": 4, "design": design, "boot": 5, "truth_laws": "held-out"}
+    here = run_bench(1, workdir=tmp_path / "here", jobs=1, **runs)
+    there = run_bench(1, workdir=tmp_path / "there", client=client, **runs)
+    files = _files(tmp_path / "here")
+    assert len([f for f in files if f.endswith(".mcap")]) == 8
+    assert b"sqlite:///WORK/c000/swtlab.sqlite" in files["c000/gap.json"]
+    assert _files(tmp_path / "there") == files
+    assert there["timing_s"]["jobs"] == 2 and here["n"] == 1
+    assert ({k: v for k, v in there.items() if k != "timing_s"}
+            == {k: v for k, v in here.items() if k != "timing_s"})
