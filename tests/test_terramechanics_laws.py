@@ -155,6 +155,18 @@ def test_rankine_bulldozing_hand_calculation():
     assert model.curves(180.0, 0.3)["dp_n"] - on["dp_n"] == pytest.approx(hand, rel=1e-9)
 
 
+def test_bekker_bulldozing_is_17_to_180_times_rankines_on_planetary_ruts():
+    # the ratio the Rankine module's docstring quotes for its fit range
+    from terramechanics.effects.bulldozing_bekker1969 import bulldozing_resistance_n
+    from terramechanics.effects.bulldozing_rankine_terzaghi1943 import rankine_passive_n_m
+
+    z, phi, c = np.meshgrid(np.linspace(0.003, 0.04, 8), np.radians(np.linspace(28, 38, 6)),
+                            np.linspace(0.0, 800.0, 5))
+    ratio = (bulldozing_resistance_n(z, 0.3, 0.12, c, phi, 15e3)
+             / (0.12 * rankine_passive_n_m(z, c, phi, 15e3)))
+    assert 16.5 < ratio.min() < 17.5 and 175 < ratio.max() < 185
+
+
 def test_scm_multipass_reloads_elastically():
     # a rerun (i >= 1) meets sigma = K_e dz: the same as a soil kc = 0, kphi = K_e, n = 1
     k_e = 4e7

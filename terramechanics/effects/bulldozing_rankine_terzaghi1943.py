@@ -10,6 +10,14 @@ wall friction and a plane failure surface, and the rut front is taken vertical: 
 shallow ruts this is far smaller than Bekker's curved-front formula
 (``bulldozing_bekker1969``, which adds the wedge ahead of the front); it holds for
 ruts shallow against the radius. ``coefficient`` scales it (1 = the formula).
+
+Its fit range stays 0-5 though Bekker's formula gives 17-180 times Rankine's on
+planetary-wheel ruts (3-40 mm, phi 28-38 deg, c up to 0.8 kPa): widened to 0-1000 to reach
+Bekker's resistances (tried in 0.6.0), Rankine's law carried a Bekker bulldozing truth in
+size but not in shape, and wheel flexibility patched the shape into confident wrong
+"wheel_flexibility + bulldozing" calls on two independent campaigns (docs/gap-report.md,
+"0.6.0"). Pinned at 5, such a fit ends on its bound, and the diagnosis says
+``inconclusive`` (``sim_gap.identify``).
 """
 
 from __future__ import annotations
