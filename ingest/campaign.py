@@ -7,12 +7,12 @@ from pathlib import Path
 
 from ingest.channel_map import ChannelMap, load_channel_map
 from ingest.errors import IngestError
-from ingest.formats import ROS2_METADATA
+from ingest.formats import BY_SUFFIX, ROS2_METADATA
 from ingest.run import Run, read_run
 
 
 #: run files found by extension (each is then read by its content, ingest.formats.sniff)
-RUN_SUFFIXES = (".mcap", ".h5", ".hdf5", ".hdf", ".mat", ".tdms", ".bag")
+RUN_SUFFIXES = tuple(BY_SUFFIX)
 
 
 @dataclass(frozen=True)
