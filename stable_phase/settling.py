@@ -87,7 +87,8 @@ def fit_settling(t_s: np.ndarray, y: np.ndarray) -> dict | None:
     if double is not None and abs(double[0][2]) / np.e >= MIN_SNR * double[1] > 0:
         (a, b, c, tau, t0), sigma = double
     return {"a": float(a), "b": float(b), "c": float(c), "tau_s": float(tau),
-            "onset_s": float(t_s[0] + t0), "residual_sigma": sigma,
+            "onset_s": float(t_s[0] + t0), "plain_onset_s": float(t_s[0] + plain[0][3]),
+            "plain_tau_s": float(plain[0][2]), "residual_sigma": sigma,
             "snr": float(max(abs(b), abs(c) / np.e) / sigma) if sigma > 0 else float("inf")}
 
 
@@ -99,6 +100,14 @@ def settling_time_s(fit: dict, fraction: float) -> float:
     transient = np.abs((fit["b"] + fit["c"] * x) * np.exp(-x))
     outside = np.flatnonzero(transient > fraction * transient.max())
     return fit["tau_s"] * float(x[outside[-1]] if outside.size else 0.0)
+
+
+def settled_at_s(fit: dict, fraction: float) -> float:
+    """When the transient is settled: the double-pole fit's settling time, never before the
+    plain exponential's (a second mode can only prolong a transient; where the double pole
+    bends the fit of the early rise instead, the plain fit's time stands)."""
+    plain = fit["plain_onset_s"] + fit["plain_tau_s"] * np.log(1.0 / fraction)
+    return max(fit["onset_s"] + settling_time_s(fit, fraction), plain)
 
 
 @register
@@ -117,7 +126,7 @@ class SettlingDetector:
         start = gate_start
         if best is not None:
             fit = fits[best]
-            start_s = fit["onset_s"] + settling_time_s(fit, params.settle_fraction)
+            start_s = settled_at_s(fit, params.settle_fraction)
             start = max(gate_start, int(np.searchsorted(t_s, start_s)))
         fallback = None
         min_samples = int(round(params.min_window_s / dt))
