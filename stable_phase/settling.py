@@ -102,12 +102,15 @@ def settling_time_s(fit: dict, fraction: float) -> float:
     return fit["tau_s"] * float(x[outside[-1]] if outside.size else 0.0)
 
 
-def settled_at_s(fit: dict, fraction: float) -> float:
+def settled_at_s(fit: dict, fraction: float, latest_s: float = np.inf) -> float:
     """When the transient is settled: the double-pole fit's settling time, never before the
     plain exponential's (a second mode can only prolong a transient; where the double pole
-    bends the fit of the early rise instead, the plain fit's time stands)."""
+    bends the fit of the early rise instead, the plain fit's time stands), and the plain
+    time where the double pole's is after ``latest_s`` (a settling the record cannot follow
+    by a window is not the record's)."""
     plain = fit["plain_onset_s"] + fit["plain_tau_s"] * np.log(1.0 / fraction)
-    return max(fit["onset_s"] + settling_time_s(fit, fraction), plain)
+    double = fit["onset_s"] + settling_time_s(fit, fraction)
+    return max(double, plain) if double <= latest_s else plain
 
 
 @register
@@ -126,7 +129,9 @@ class SettlingDetector:
         start = gate_start
         if best is not None:
             fit = fits[best]
-            start_s = settled_at_s(fit, params.settle_fraction)
+            # the window after it must survive the end cut and the whole-period trim
+            room_s = params.min_window_s / (1.0 - params.end_max_cut_fraction) + (period_s or 0)
+            start_s = settled_at_s(fit, params.settle_fraction, float(t_s[-1]) - room_s)
             start = max(gate_start, int(np.searchsorted(t_s, start_s)))
         fallback = None
         min_samples = int(round(params.min_window_s / dt))
