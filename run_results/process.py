@@ -29,8 +29,7 @@ from run_results.phase_average import phase_average
 from run_results.plausibility import plausibility_flags
 from run_results.rest_readings import rest_readings
 from run_results.result import RunResult
-from run_results.stats import (BATCHES, RATE_BATCHES, QuantityStats, batch_means_se,
-                                quantity_stats)
+from run_results.stats import QuantityStats, batch_means_se, quantity_stats
 from run_results.traces import run_traces
 from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
@@ -189,8 +188,7 @@ def process_run(run, params: StablePhaseParams | None = None,
             quantities[key] = stats
             if key in RATES or average is not None:
                 batches[key] = batch_means_se(y[lo:hi], None if average is None
-                                              else average["periodic"],
-                                              RATE_BATCHES if key in RATES else BATCHES)
+                                              else average["periodic"])
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     quantities.update({k: v for k, v in native.items() if k in quantities})

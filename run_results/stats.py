@@ -65,10 +65,8 @@ def quantity_stats(y, unit: str, average: dict | None = None) -> QuantityStats |
 
 
 
-#: batches of :func:`batch_means_se`; a rate's (slip, speeds) fewer: Schmeiser's (1982)
-#: 10-30 batches at the end that keeps the batch means' correlation (a drive's ripple of
-#: 0.7 s against batches of a 15 s window) inside the lag-1 term
-BATCHES, RATE_BATCHES = 20, 10
+#: batches of :func:`batch_means_se`
+BATCHES = 20
 
 
 def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, float] | None:

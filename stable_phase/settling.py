@@ -56,10 +56,11 @@ def _fit(model, t, y, p0, lower, upper):
     return p, float(np.std(y - model(t, *p)))
 
 
-def fit_settling(t_s: np.ndarray, y: np.ndarray) -> dict | None:
+def fit_settling(t_s: np.ndarray, y: np.ndarray, double_pole: bool = True) -> dict | None:
     """Least-squares settling fit; None when it cannot be fitted.
 
-    First ``a + b exp(-s/tau)`` (``s = max(t - t_on, 0)``); then ``a + (b + c s/tau)
+    First ``a + b exp(-s/tau)`` (``s = max(t - t_on, 0)``); then (``double_pole``)
+    ``a + (b + c s/tau)
     exp(-s/tau)``, the step response of a second-order system with a double pole (Ogata
     2010, Modern Control Engineering, 5th ed., sec. 5-3, critically damped case), which also
     follows a transient that rises past its final value and creeps back. ``c`` is kept
@@ -78,7 +79,8 @@ def fit_settling(t_s: np.ndarray, y: np.ndarray) -> dict | None:
         return None
     (a, b, tau, t0), sigma = plain
     c = 0.0
-    starts = [(a, b, b * c_ratio, tau * tau_ratio, t0) for c_ratio, tau_ratio in DOUBLE_STARTS]
+    starts = [(a, b, b * c_ratio, tau * tau_ratio, t0)
+              for c_ratio, tau_ratio in (DOUBLE_STARTS if double_pole else ())]
     fits = [f for f in (_fit(_repeated_pole, t, y, p0, [-np.inf, -np.inf, -np.inf, 1e-3 * span,
                                                          0.0],
                              [np.inf, np.inf, np.inf, 2.0 * span, 0.5 * span]) for p0 in starts)
@@ -117,12 +119,14 @@ def settled_at_s(fit: dict, fraction: float, latest_s: float = np.inf) -> float:
 class SettlingDetector:
     name = "settling"
     description = "exponential-settling fit (0.5 % band) + MSER end cut"
+    double_pole = False
 
     def locate(self, t_s, signals, period_s, params, gate_start) -> Cut:
         dt = float(np.median(np.diff(t_s)))
         width = max(int(round((period_s or params.batch_s) / dt)), 1)
         step = -(-t_s.size // FIT_POINTS)
-        fits = {name: fit_settling(t_s[::step], moving_average(y, width, full_only=True)[::step])
+        fits = {name: fit_settling(t_s[::step], moving_average(y, width, full_only=True)[::step],
+                                   self.double_pole)
                 for name, y in signals.items()}
         fits = {k: v for k, v in fits.items() if v is not None}
         best = next((k for k, v in fits.items() if v["snr"] >= MIN_SNR), None)
@@ -148,3 +152,14 @@ class SettlingDetector:
                 stop = int(centres[centres.size - 1 - d2]) + 1
         return Cut(start, max(stop, start),
                    {"settling_fits": fits, "settling_signal": best, "fallback": fallback})
+
+
+@register
+class OvershootSettlingDetector(SettlingDetector):
+    """``settling`` with the double-pole term (``fit_settling``): a transient that rises past
+    its final value and creeps back opens the window later. Not the default yet: its later
+    windows (12-20 s on the second rig) make the grouser-frequency check flag runs."""
+
+    name = "settling_overshoot"
+    description = "exponential/double-pole settling fit (0.5 % band) + MSER end cut"
+    double_pole = True
