@@ -34,50 +34,108 @@ MIN_SNR = 10.0
 #: the smoothed signals are fitted on at most this many points (decimated after the
 #: period-long moving average, which has already removed what decimation would alias)
 FIT_POINTS = 5000
+#: starts of the double-pole fit, ``(c/b, tau/tau_plain)``: a plain exponential, and one
+#: rising past its final value (c against b) at the plain and twice the plain time constant
+DOUBLE_STARTS = ((0.0, 1.0), (-1.0, 1.0), (-1.0, 2.0), (-2.0, 2.0))
 
 
 def _exponential(t, a, b, tau, t0):
     return a + b * np.exp(-np.clip(t - t0, 0.0, None) / tau)
 
 
-def fit_settling(t_s: np.ndarray, y: np.ndarray) -> dict | None:
-    """Least-squares exponential settling fit; None when it cannot be fitted."""
+def _repeated_pole(t, a, b, c, tau, t0):
+    x = np.clip(t - t0, 0.0, None) / tau
+    return a + (b + c * x) * np.exp(-x)
+
+
+def _fit(model, t, y, p0, lower, upper):
+    try:
+        p, _ = curve_fit(model, t, y, p0=p0, bounds=(lower, upper))
+    except (RuntimeError, ValueError):
+        return None
+    return p, float(np.std(y - model(t, *p)))
+
+
+def fit_settling(t_s: np.ndarray, y: np.ndarray, double_pole: bool = True) -> dict | None:
+    """Least-squares settling fit; None when it cannot be fitted.
+
+    First ``a + b exp(-s/tau)`` (``s = max(t - t_on, 0)``); then (``double_pole``)
+    ``a + (b + c s/tau)
+    exp(-s/tau)``, the step response of a second-order system with a double pole (Ogata
+    2010, Modern Control Engineering, 5th ed., sec. 5-3, critically damped case), which also
+    follows a transient that rises past its final value and creeps back. ``c`` is kept
+    (``c_term``) only when that term stands out from the residual as a transient must
+    (peak ``|c|/e >= MIN_SNR`` sigma), else 0: a plain exponential keeps its plain fit.
+    """
     ok = np.isfinite(y)
     if ok.sum() < 10:
         return None
     t, y = t_s[ok] - t_s[0], y[ok]
     span = float(t[-1])
     a0 = float(np.median(y[t >= 0.75 * span]))
-    p0 = (a0, float(y[0] - a0), span / 10.0, 0.0)
-    try:
-        p, _ = curve_fit(_exponential, t, y, p0=p0,
-                         bounds=([-np.inf, -np.inf, 1e-3 * span, 0.0],
-                                 [np.inf, np.inf, 2.0 * span, 0.5 * span]))
-    except (RuntimeError, ValueError):
+    plain = _fit(_exponential, t, y, (a0, float(y[0] - a0), span / 10.0, 0.0),
+                 [-np.inf, -np.inf, 1e-3 * span, 0.0], [np.inf, np.inf, 2.0 * span, 0.5 * span])
+    if plain is None:
         return None
-    sigma = float(np.std(y - _exponential(t, *p)))
-    return {"a": float(p[0]), "b": float(p[1]), "tau_s": float(p[2]),
-            "onset_s": float(t_s[0] + p[3]), "residual_sigma": sigma,
-            "snr": float(abs(p[1]) / sigma) if sigma > 0 else float("inf")}
+    (a, b, tau, t0), sigma = plain
+    c = 0.0
+    starts = [(a, b, b * c_ratio, tau * tau_ratio, t0)
+              for c_ratio, tau_ratio in (DOUBLE_STARTS if double_pole else ())]
+    fits = [f for f in (_fit(_repeated_pole, t, y, p0, [-np.inf, -np.inf, -np.inf, 1e-3 * span,
+                                                         0.0],
+                             [np.inf, np.inf, np.inf, 2.0 * span, 0.5 * span]) for p0 in starts)
+            if f is not None]
+    double = min(fits, key=lambda f: f[1], default=None)
+    if double is not None and abs(double[0][2]) / np.e >= MIN_SNR * double[1] > 0:
+        (a, b, c, tau, t0), sigma = double
+    return {"a": float(a), "b": float(b), "c": float(c), "tau_s": float(tau),
+            "onset_s": float(t_s[0] + t0), "plain_onset_s": float(t_s[0] + plain[0][3]),
+            "plain_tau_s": float(plain[0][2]), "residual_sigma": sigma,
+            "snr": float(max(abs(b), abs(c) / np.e) / sigma) if sigma > 0 else float("inf")}
+
+
+def settling_time_s(fit: dict, fraction: float) -> float:
+    """Time from the onset after which the fitted transient ``(b + c x) exp(-x)``,
+    ``x = s/tau``, stays within ``fraction`` of its largest excursion (``tau ln(1/f)`` for
+    a plain exponential)."""
+    x = np.linspace(0.0, 60.0, 60001)
+    transient = np.abs((fit["b"] + fit["c"] * x) * np.exp(-x))
+    outside = np.flatnonzero(transient > fraction * transient.max())
+    return fit["tau_s"] * float(x[outside[-1]] if outside.size else 0.0)
+
+
+def settled_at_s(fit: dict, fraction: float, latest_s: float = np.inf) -> float:
+    """When the transient is settled: the double-pole fit's settling time, never before the
+    plain exponential's (a second mode can only prolong a transient; where the double pole
+    bends the fit of the early rise instead, the plain fit's time stands), and the plain
+    time where the double pole's is after ``latest_s`` (a settling the record cannot follow
+    by a window is not the record's)."""
+    plain = fit["plain_onset_s"] + fit["plain_tau_s"] * np.log(1.0 / fraction)
+    double = fit["onset_s"] + settling_time_s(fit, fraction)
+    return max(double, plain) if double <= latest_s else plain
 
 
 @register
 class SettlingDetector:
     name = "settling"
     description = "exponential-settling fit (0.5 % band) + MSER end cut"
+    double_pole = False
 
     def locate(self, t_s, signals, period_s, params, gate_start) -> Cut:
         dt = float(np.median(np.diff(t_s)))
         width = max(int(round((period_s or params.batch_s) / dt)), 1)
         step = -(-t_s.size // FIT_POINTS)
-        fits = {name: fit_settling(t_s[::step], moving_average(y, width, full_only=True)[::step])
+        fits = {name: fit_settling(t_s[::step], moving_average(y, width, full_only=True)[::step],
+                                   self.double_pole)
                 for name, y in signals.items()}
         fits = {k: v for k, v in fits.items() if v is not None}
         best = next((k for k, v in fits.items() if v["snr"] >= MIN_SNR), None)
         start = gate_start
         if best is not None:
             fit = fits[best]
-            start_s = fit["onset_s"] + fit["tau_s"] * np.log(1.0 / params.settle_fraction)
+            # the window after it must survive the end cut and the whole-period trim
+            room_s = params.min_window_s / (1.0 - params.end_max_cut_fraction) + (period_s or 0)
+            start_s = settled_at_s(fit, params.settle_fraction, float(t_s[-1]) - room_s)
             start = max(gate_start, int(np.searchsorted(t_s, start_s)))
         fallback = None
         min_samples = int(round(params.min_window_s / dt))
@@ -94,3 +152,14 @@ class SettlingDetector:
                 stop = int(centres[centres.size - 1 - d2]) + 1
         return Cut(start, max(stop, start),
                    {"settling_fits": fits, "settling_signal": best, "fallback": fallback})
+
+
+@register
+class OvershootSettlingDetector(SettlingDetector):
+    """``settling`` with the double-pole term (``fit_settling``): a transient that rises past
+    its final value and creeps back opens the window later. Not the default yet: its later
+    windows (12-20 s on the second rig) make the grouser-frequency check flag runs."""
+
+    name = "settling_overshoot"
+    description = "exponential/double-pole settling fit (0.5 % band) + MSER end cut"
+    double_pole = True

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 from scipy.signal import lfilter
 
 from stable_phase.autocorr import standard_error, statistical_inefficiency
@@ -11,7 +12,7 @@ from stable_phase.checks import half_change, slope_test, split_r_hat
 from stable_phase.gate import bridge_dropouts, surface_speed_setpoint_mps
 from stable_phase.mser import mser_two_sided
 from stable_phase.params import StablePhaseParams
-from stable_phase.settling import fit_settling
+from stable_phase.settling import fit_settling, settled_at_s, settling_time_s
 from stable_phase.signals import grouser_period_s, longest_true_run, moving_average
 
 
@@ -68,6 +69,49 @@ def test_settling_fit_recovers_onset_and_time_constant():
     fit = fit_settling(t, y + np.random.default_rng(1).normal(0, 0.002, t.size))
     assert fit["tau_s"] == pytest.approx(5.0, rel=0.03)
     assert fit["onset_s"] == pytest.approx(3.0, abs=0.3) and fit["snr"] > 100
+
+
+
+def test_plain_exponential_keeps_the_plain_settling_time():
+    """No double-pole term where there is none: settled 5.30 tau (``ln 200``) after onset."""
+    t = np.linspace(0, 60, 2401)
+    y = 4.0 - 1.5 * np.exp(-np.clip(t - 3.0, 0, None) / 5.0)
+    fit = fit_settling(t, y + np.random.default_rng(1).normal(0, 0.002, t.size))
+    assert fit["c"] == 0.0
+    assert settled_at_s(fit, 0.005) == pytest.approx(3.0 + 5.0 * np.log(200.0), rel=0.03)
+
+
+def test_critically_damped_settling_time():
+    """Critically damped step response ``1 - (1 + x) e^-x``, ``x = (t - 3 s)/2 s`` (Ogata
+    2010, sec. 5-3): within 0.5 % once ``(1 + x) e^-x = 0.005``, x = 7.4301 (Newton by hand
+    from 7.5), i.e. 14.86 s after the onset."""
+    t = np.linspace(0, 60, 3001)
+    x = np.clip(t - 3.0, 0, None) / 2.0
+    y = 10.0 - 2.0 * (1 + x) * np.exp(-x) + np.random.default_rng(3).normal(0, 0.002, t.size)
+    fit = fit_settling(t, y)
+    assert fit["c"] != 0.0 and fit["onset_s"] == pytest.approx(3.0, abs=0.1)
+    assert settling_time_s(fit, 0.005) == pytest.approx(2.0 * 7.4301, rel=0.03)
+
+
+def test_overshoot_that_creeps_back_delays_the_window():
+    """A fast rise past the final value and a slow creep back, ``-3 e^(-s/1.5) + 0.4
+    e^(-s/6)`` from 3 s (two modes, not the fitted family): within 0.5 % of its largest
+    excursion (2.6) at the root of that sum = 0.013, 23.56 s (closed form, solved apart).
+    The plain exponential follows the rise and opens before 10 s; the double pole must open
+    later and leave at most 40 % of the creep's bias in the window mean (it opens about
+    17 s: the double pole decays faster than the slow mode, so not all of it)."""
+    t = np.linspace(0, 60, 3001)
+    s = np.clip(t - 3.0, 0, None)
+    transient = -3.0 * np.exp(-s / 1.5) + 0.4 * np.exp(-s / 6.0)
+    fit = fit_settling(t, 5.0 + transient + np.random.default_rng(5).normal(0, 0.002, t.size))
+    plain_s = fit["plain_onset_s"] + fit["plain_tau_s"] * np.log(200.0)
+    start_s = settled_at_s(fit, 0.005)
+    truth_s = 3.0 + brentq(lambda x: -3.0 * np.exp(-x / 1.5) + 0.4 * np.exp(-x / 6.0) - 0.013,
+                           5.0, 40.0)
+    assert truth_s == pytest.approx(23.56, abs=0.01)
+    assert plain_s < 10.0 and 15.0 < start_s <= truth_s
+    bias = [np.mean(transient[t >= t0]) for t0 in (start_s, plain_s)]
+    assert bias[0] < 0.4 * bias[1]  # measured 0.34
 
 
 def test_slope_test_and_r_hat():
