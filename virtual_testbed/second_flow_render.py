@@ -192,9 +192,9 @@ def render_second(scene: SecondScene,
     dist = np.hypot(gx - ax, gy - ay)
     wheel_cover = np.clip(scene.rim_px - dist + 0.5, 0, 1)
     frames, times = [], np.arange(n_frames) / scene.fps
+    qx, qy = gx, gy
     for n in range(n_frames):
-        qx, qy = gx.copy(), gy.copy()
-        for _ in range(n):
+        if n:  # phi^-n = phi^-1 applied to phi^-(n-1)
             qx, qy = _inverse_step(scene, qx, qy)
         taps = np.linspace(-0.5, 0.5, 7) * scene.blur_fraction
         soil = np.zeros_like(gx)
@@ -219,7 +219,7 @@ def render_second(scene: SecondScene,
         if not ok:
             raise RuntimeError("JPEG encoding failed")
         frames.append(cv2.imdecode(enc, cv2.IMREAD_GRAYSCALE))
-    return frames, times, _truth(scene)
+    return frames, times, scene_truth(scene)
 
 
 def _background(scene: SecondScene, x, y, shift_px: float, phase) -> np.ndarray:
@@ -257,7 +257,8 @@ def _grouser_cover(scene: SecondScene, x, y, angle: float) -> np.ndarray:
             * np.clip(scene.tip_px - dist + 0.5, 0, 1) * np.clip(dist - scene.rim_px + 1.0, 0, 1))
 
 
-def _truth(scene: SecondScene) -> dict:
+def scene_truth(scene: SecondScene) -> dict:
+    """The truth of a scene (also returned by :func:`render_second`)."""
     beta = np.deg2rad(np.arange(-175.0, 180.0, 10.0))
     theta = np.arctan2(scene.direction * np.cos(beta), -np.sin(beta))
     return {"schema": "swtlab.virtual_testbed.second_flow_render/1", "scene": asdict(scene),
