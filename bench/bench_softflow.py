@@ -312,7 +312,8 @@ def _second_run(seed: int, slip: float, grousers: bool):
     return frames, t_s, scene.px_per_m, truth
 
 
-def decay_rates(seeds: tuple[int, ...] = DECAY_SEEDS) -> dict:
+def decay_rates(seeds: tuple[int, ...] = DECAY_SEEDS,
+                renderers: tuple[str, ...] = ("second", "first")) -> dict:
     """Both renderers, without and with grousers (count and height given, as ``swt.wheel``
     gives them; no centre or radius hint), slips 0.1-0.7 over ``seeds``: wheel centre
     and radius error, sled velocity error, and ``k`` / ``alpha3`` within 5 % over the contact
@@ -320,7 +321,9 @@ def decay_rates(seeds: tuple[int, ...] = DECAY_SEEDS) -> dict:
     least 30 % of the travel velocity; an unfitted bin counts as a miss.
     ``DECAY_FRAMES`` frames a run."""
     table = {}
-    for name, run in (("first", _first_run), ("second", _second_run)):
+    runs = {"first": _first_run, "second": _second_run}
+    for name in renderers:
+        run = runs[name]
         for grousers in (False, True):
             centre, radius, sled, k_err, a3_err, failed = [], [], [], [], [], 0
             for i, seed in enumerate(seeds):
@@ -333,6 +336,8 @@ def decay_rates(seeds: tuple[int, ...] = DECAY_SEEDS) -> dict:
                 except ValueError:
                     failed += 1
                     continue
+                print(f"  {name} grousers={grousers} seed {seed} slip {slip:.2f}: sled "
+                      f"{res.sled_velocity_mps[0] / truth['sled'] - 1:+.4f}", flush=True)
                 p0 = res.poses[0]
                 centre.append(float(np.hypot(*np.subtract(p0.center_px, truth["centre"]))))
                 radius.append(abs(p0.radius_px - truth["radius"]))
