@@ -42,9 +42,10 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
+from softflow.flow_engine import BORDER_PX  # dropped at the image edge: windows cut by it
+
 SIGMA_PX = 5.0  # derivative scale: smallest eps error on renders (docs/softflow.md)
 UNDISTURBED = 0.01  # |u + V| / |V| where a streamline may end
-BORDER_PX = 8  # dropped at the image edge: flow windows cut by the border
 CLOSER_PX = 2.0  # a path may come this much closer to the axle than its start point
 SAMPLES_PER_BIN = 5
 #: eps error of a field measured from frames beyond the exact field's, worst bin on the

@@ -6,7 +6,8 @@ import cv2
 import numpy as np
 import pytest
 
-from softflow.flow_engine import average_flow, normalised_median_outliers, pair_displacement_px
+from softflow.flow_engine import (BORDER_PX, average_flow, normalised_median_outliers,
+                                  pair_displacement_px)
 from virtual_testbed.flow_render import BETA_GRID, FlowScene, render_flow
 
 
@@ -83,6 +84,12 @@ def test_average_in_velocity_units(render):
     assert np.sqrt(np.mean(err ** 2)) < 0.04
     assert mean.outlier_fraction < 0.02  # small-window field: ~1.3 % flagged at eps 0.1 px
     assert np.isnan(mean.velocity_px_per_s[100, 160]).all()  # inside the wheel
+    # vectors at the image border are rejected (biased low there: the warp leaves the image)
+    b = BORDER_PX
+    v = mean.velocity_px_per_s
+    assert np.isnan(v[:b]).all() and np.isnan(v[-b:]).all()
+    assert np.isnan(v[:, :b]).all() and np.isnan(v[:, -b:]).all()
+    assert np.isfinite(v[-b - 1, 2 * b:-2 * b, 0]).mean() > 0.9  # just inside: kept
 
 
 def test_cli_engine_choices_match_the_engines():

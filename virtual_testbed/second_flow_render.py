@@ -21,6 +21,16 @@ exact pair displacement); frame ``n`` shows the texture at ``phi^-n(x)``, the in
 map applied ``n`` times (fixed-point iteration, 12 steps, error < 1e-6 px). The decay
 laws are this module's own: ``k(th) = k0 (1 + 0.2 sin(th + 0.4))``,
 ``a3(th) = a0 (1 + 0.15 cos(2 th))``.
+
+Grousers (``grouser_count`` > 0; this module's own kinematics, not the effective-radius
+models of the first renderer): ``grouser_count`` straight bars ``grouser_width_px`` wide,
+standing ``grouser_height_px`` out of the rim, drawn as uniform grey and turning with the
+wheel. The soil between them is carried by the wheel (rigid rotation about the axle, steady
+in the camera), and outside the tip circle ``R_t = R + h`` the soil is sheared by the tips:
+the laws above with the depth counted from ``R_t`` and the tips' speed ``w R_t`` in place of
+``R w`` (slip still defined on the rim, ``R w = V / (1 - slip)``). The two agree at ``R_t``
+(both the rigid-body velocity of the wheel there), and at fixed ``th`` the profiles are still
+``exp(-rate (r - R))`` with the same rates, only their amplitudes change.
 """
 
 from __future__ import annotations
@@ -64,12 +74,21 @@ class SecondScene:
     noise_std: float = 2.5
     jpeg_quality: int = 80
     supersample: int = 3
+    grouser_count: int = 0
+    grouser_height_px: float = 0.0
+    grouser_width_px: float = 5.0
+    grouser_grey: float = 70.0
     seed: int = 0
 
     @property
     def surface_px(self) -> float:
         return self.axle_px[1] + 0.55 * self.rim_px if self.soil_top_px is None \
             else self.soil_top_px
+
+    @property
+    def tip_px(self) -> float:
+        """Radius of the grouser tips (the rim without grousers)."""
+        return self.rim_px + (self.grouser_height_px if self.grouser_count else 0.0)
 
     @property
     def omega_radps(self) -> float:
@@ -89,9 +108,10 @@ def camera_velocity_px(scene: SecondScene, x: np.ndarray, y: np.ndarray):
     ex, ey = x - scene.axle_px[0], y - scene.axle_px[1]
     dist = np.sqrt(ex * ex + ey * ey)
     th = np.arctan2(scene.direction * ex, ey)
-    depth_m = np.clip(dist - scene.rim_px, 0.0, None) / scene.px_per_m
+    depth_m = np.clip(dist - scene.tip_px, 0.0, None) / scene.px_per_m
     v = scene.speed_mps
-    rim_speed = scene.omega_radps * scene.rim_px / scene.px_per_m
+    # carried by the wheel between the grousers, sheared by the tips outside them
+    rim_speed = scene.omega_radps * np.clip(dist, scene.rim_px, scene.tip_px) / scene.px_per_m
     radial = v * np.sin(th) * np.exp(-radial_rate_per_m(scene, th) * depth_m)
     tangential = (v * np.cos(th) - rim_speed) * np.exp(-tangential_rate_per_m(scene, th) * depth_m)
     along = radial * np.sin(th) + tangential * np.cos(th) - v  # along travel
@@ -172,9 +192,9 @@ def render_second(scene: SecondScene,
     dist = np.hypot(gx - ax, gy - ay)
     wheel_cover = np.clip(scene.rim_px - dist + 0.5, 0, 1)
     frames, times = [], np.arange(n_frames) / scene.fps
+    qx, qy = gx, gy
     for n in range(n_frames):
-        qx, qy = gx.copy(), gy.copy()
-        for _ in range(n):
+        if n:  # phi^-n = phi^-1 applied to phi^-(n-1)
             qx, qy = _inverse_step(scene, qx, qy)
         taps = np.linspace(-0.5, 0.5, 7) * scene.blur_fraction
         soil = np.zeros_like(gx)
@@ -189,6 +209,8 @@ def render_second(scene: SecondScene,
         img = above * (1 - in_soil) + soil * in_soil
         angle = scene.omega_radps * times[n]
         img = img * (1 - wheel_cover) + _wheel_grey(scene, gx, gy, angle) * wheel_cover
+        bars = _grouser_cover(scene, gx, gy, angle)
+        img = img * (1 - bars) + scene.grouser_grey * bars
         img = img.reshape(h, s, w, s).mean(axis=(1, 3))
         img = (img + refl) * vignette * (1 + scene.flicker * rng.standard_normal())
         img += scene.noise_std * rng.standard_normal(img.shape)
@@ -197,7 +219,7 @@ def render_second(scene: SecondScene,
         if not ok:
             raise RuntimeError("JPEG encoding failed")
         frames.append(cv2.imdecode(enc, cv2.IMREAD_GRAYSCALE))
-    return frames, times, _truth(scene)
+    return frames, times, scene_truth(scene)
 
 
 def _background(scene: SecondScene, x, y, shift_px: float, phase) -> np.ndarray:
@@ -221,13 +243,33 @@ def _wheel_grey(scene: SecondScene, x, y, angle: float) -> np.ndarray:
     return np.where(r > 0.88, 55.0, 100.0 + spokes)
 
 
-def _truth(scene: SecondScene) -> dict:
+def _grouser_cover(scene: SecondScene, x, y, angle: float) -> np.ndarray:
+    """Coverage 0..1 of the grouser bars (grouser 0 at ``th = -angle``, the wheel turned by
+    ``angle``); 0 everywhere without grousers."""
+    if not scene.grouser_count:
+        return np.zeros_like(x)
+    ex, ey = x - scene.axle_px[0], y - scene.axle_px[1]
+    dist = np.hypot(ex, ey)
+    pitch = 2 * np.pi / scene.grouser_count
+    rel = np.arctan2(scene.direction * ex, ey) + angle
+    across = dist * np.abs(np.sin(rel - pitch * np.round(rel / pitch)))
+    return (np.clip(scene.grouser_width_px / 2 - across + 0.5, 0, 1)
+            * np.clip(scene.tip_px - dist + 0.5, 0, 1) * np.clip(dist - scene.rim_px + 1.0, 0, 1))
+
+
+def scene_truth(scene: SecondScene) -> dict:
+    """The truth of a scene (also returned by :func:`render_second`)."""
     beta = np.deg2rad(np.arange(-175.0, 180.0, 10.0))
     theta = np.arctan2(scene.direction * np.cos(beta), -np.sin(beta))
     return {"schema": "swtlab.virtual_testbed.second_flow_render/1", "scene": asdict(scene),
             "wheel_center_px": list(scene.axle_px), "wheel_radius_px": scene.rim_px,
             "sled_velocity_mps": [scene.direction * scene.speed_mps, 0.0],
             "omega_radps": scene.omega_radps, "soil_surface_px": scene.surface_px,
+            "grouser_tip_px": scene.tip_px,
+            # soil velocity at the tip circle (the rim without grousers), bin frame
+            "radial_rim_velocity_mps": (scene.speed_mps * np.sin(theta)).tolist(),
+            "tangential_rim_velocity_mps": (scene.speed_mps * np.cos(theta) - scene.omega_radps
+                                            * scene.tip_px / scene.px_per_m).tolist(),
             "beta_deg": np.rad2deg(beta).tolist(),
             "radial_decay_per_m": radial_rate_per_m(scene, theta).tolist(),
             "tangential_decay_per_m": tangential_rate_per_m(scene, theta).tolist()}
