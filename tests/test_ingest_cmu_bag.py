@@ -121,19 +121,24 @@ def _records(rows, force, row_log_ns, ft_ns, ft_type=READING):
     return sorted(out, key=lambda x: (x[0], x[1]))
 
 
+def _write_records(writer, messages, records, serialize) -> None:
+    """Each ``(ns, topic, msgtype, build)`` record through a rosbags ``writer``, one
+    connection per topic, serialised by ``serialize`` (ROS 1 or CDR)."""
+    connections = {}
+    for ns, topic, msgtype, build in records:
+        if topic not in connections:
+            connections[topic] = writer.add_connection(topic, msgtype,
+                                                       typestore=messages.store)
+        writer.write(connections[topic], ns, serialize(build(messages), msgtype))
+
+
 def _write_ros1(path: Path, records) -> Path:
     from rosbags.rosbag1 import Writer
 
     messages = _Messages(_store(ros2=False))
     path.parent.mkdir(parents=True, exist_ok=True)
     with Writer(path) as writer:
-        connections = {}
-        for ns, topic, msgtype, build in records:
-            if topic not in connections:
-                connections[topic] = writer.add_connection(topic, msgtype,
-                                                           typestore=messages.store)
-            writer.write(connections[topic], ns,
-                         messages.store.serialize_ros1(build(messages), msgtype))
+        _write_records(writer, messages, records, messages.store.serialize_ros1)
     return path
 
 
@@ -144,13 +149,7 @@ def _write_ros2_without_definitions(folder: Path, records, store=None) -> Path:
     messages = _Messages(store or _store(ros2=True))
     folder.parent.mkdir(parents=True, exist_ok=True)
     with Writer(folder, version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
-        connections = {}
-        for ns, topic, msgtype, build in records:
-            if topic not in connections:
-                connections[topic] = writer.add_connection(topic, msgtype,
-                                                           typestore=messages.store)
-            writer.write(connections[topic], ns,
-                         messages.store.serialize_cdr(build(messages), msgtype))
+        _write_records(writer, messages, records, messages.store.serialize_cdr)
     for db in folder.glob("*.db3"):
         with sqlite3.connect(db) as con:
             con.execute("DELETE FROM message_definitions")
