@@ -6,11 +6,11 @@ import numpy as np
 
 
 def median(x: np.ndarray) -> float:
-    """``np.median`` of a non-empty 1-D float array, the same number (NaN if any sample is),
+    """``np.median`` of a 1-D float array, the same number (NaN if a sample is, or none is),
     from one partition at the upper middle and the largest sample below it: np.median
     partitions at both middles and at the end (for NaN), several times slower on long
     arrays."""
-    if np.isnan(x).any():
+    if x.size == 0 or np.isnan(x).any():
         return float("nan")
     half = x.size // 2
     part = np.partition(x, half)
