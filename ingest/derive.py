@@ -28,7 +28,8 @@ def quantisation_step(x: np.ndarray) -> float:
     Tries q = (smallest level spacing)/k for k = 1..1000; 0.0 when the levels are not
     on a lattice (a continuous signal, or steps far finer than the motion per sample).
     """
-    levels = np.unique(x)
+    levels = np.sort(x, kind="stable")  # np.unique's levels; an encoder's rising counts are
+    levels = levels[np.r_[True, levels[1:] != levels[:-1]]]  # one run for the stable sort
     spacing = np.diff(levels)
     spacing = spacing[spacing > 1e-12 * max(1.0, float(np.abs(levels).max(initial=0.0)))]
     if len(spacing) == 0:
