@@ -28,6 +28,8 @@ def quantisation_step(x: np.ndarray) -> float:
     Tries q = (smallest level spacing)/k for k = 1..1000; 0.0 when the levels are not
     on a lattice (a continuous signal, or steps far finer than the motion per sample).
     """
+    if len(x) < 2:
+        return 0.0
     levels = np.sort(x, kind="stable")  # np.unique's levels; an encoder's rising counts are
     levels = levels[np.r_[True, levels[1:] != levels[:-1]]]  # one run for the stable sort
     spacing = np.diff(levels)
