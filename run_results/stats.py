@@ -127,10 +127,11 @@ def pitch_batch_means_se(y, pitch: int, periodic=None) -> tuple[float, float] | 
     lags (``c < 0``), inside a window the load cells' drift, is the zero-drift term's and is
     not extrapolated here (unconstrained, it raised the virtual testbed's DP, load and R
     coverage by 1.5-2.4 points on seed 101). On synthetic windows (tests) it is low by about
-    10 % in variance on white noise, where the fit drops a negative ``a``. ``dof = 1.5 (n/pitch - 1)``: those of overlapping batch means of
+    10 % in variance on white noise, where the fit drops a negative ``a``.
+    ``dof = 1.5 (n/pitch - 1)``: those of overlapping batch means of
     one pitch, where the fit has most of its information (their variance 2/3 of
-    non-overlapping batches', Meketon & Schmeiser 1984). With two pitches only, ``var_L``
-    of one pitch. None with fewer than two pitches or a pitch under 2 samples."""
+    non-overlapping batches', Meketon & Schmeiser 1984). With two or three pitches (one value
+    of ``(n - L) L``), the mean of their ``var_L``: plain overlapping batch means. None with fewer than two pitches or a pitch under 2 samples."""
     y = np.asarray(y, float)
     if periodic is not None:
         y = y - np.nan_to_num(np.asarray(periodic, float))
@@ -140,8 +141,9 @@ def pitch_batch_means_se(y, pitch: int, periodic=None) -> tuple[float, float] | 
         return None
     sizes = m * np.arange(1, max(n // m - 1, 1) + 1)
     var = np.array([_obm_var(y, int(size)) for size in sizes])
-    if sizes.size > 1:
-        design = np.column_stack([np.ones(sizes.size), 1.0 / ((n - sizes) * sizes)])
-        (a, c), _ = optimize.nnls(design, var)
-        var = np.array([a + c / n**2])
-    return float(np.sqrt(max(var[0], 0.0))), 1.5 * (n / m - 1.0)
+    x = 1.0 / ((n - sizes) * sizes)
+    estimate = float(var.mean())
+    if np.ptp(x) > 0:
+        (a, c), _ = optimize.nnls(np.column_stack([np.ones(x.size), x]), var)
+        estimate = a + c / n**2
+    return float(np.sqrt(estimate)), 1.5 * (n / m - 1.0)
