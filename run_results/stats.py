@@ -128,10 +128,11 @@ def pitch_batch_means_se(y, pitch: int, periodic=None) -> tuple[float, float] | 
     not extrapolated here (unconstrained, it raised the virtual testbed's DP, load and R
     coverage by 1.5-2.4 points on seed 101). On synthetic windows (tests) it is low by about
     10 % in variance on white noise, where the fit drops a negative ``a``.
-    ``dof = 1.5 (n/pitch - 1)``: those of overlapping batch means of
-    one pitch, where the fit has most of its information (their variance 2/3 of
-    non-overlapping batches', Meketon & Schmeiser 1984). With two or three pitches (one value
-    of ``(n - L) L``), the mean of their ``var_L``: plain overlapping batch means. None with fewer than two pitches or a pitch under 2 samples."""
+    ``dof = 1.5 (n/pitch - 1)``: those of overlapping batch means of one pitch, where the fit
+    has most of its information (their variance 2/3 of non-overlapping batches', Meketon &
+    Schmeiser 1984). With two or three pitches (one value of ``(n - L) L``), the mean of
+    their ``var_L``: plain overlapping batch means. None with fewer than two pitches or a
+    pitch under 2 samples."""
     y = np.asarray(y, float)
     if periodic is not None:
         y = y - np.nan_to_num(np.asarray(periodic, float))
