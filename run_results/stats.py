@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from scipy import optimize
 
 from stable_phase.autocorr import statistical_inefficiency
 
@@ -99,3 +100,51 @@ def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, flo
     var = (float(d @ d) + 2.0 * float(d[1:] @ d[:-1])) / ((batches - 1) * (batches - 2))
     dof = (batches - 1) * (batches - 2) ** 2 / (3.0 * batches**2)
     return float(np.sqrt(max(var, 0.0))), dof
+
+
+
+def _obm_var(y: np.ndarray, batch: int) -> float:
+    """Overlapping-batch-means estimate of ``var(mean)`` with batches of ``batch`` samples
+    (Meketon & Schmeiser 1984): ``m sum_j (ybar_j - ybar)^2 / ((n - m + 1)(n - m))``."""
+    n, m = y.size, batch
+    sums = np.cumsum(np.concatenate([[0.0], y - y.mean()]))
+    d = (sums[m:] - sums[:-m]) / m
+    return m * float(d @ d) / ((n - m + 1) * (n - m))
+
+
+def pitch_batch_means_se(y, pitch: int, periodic=None) -> tuple[float, float] | None:
+    """``(se, dof)`` of the window mean of a signal carrying a wave that averages to zero
+    over each grouser pitch but wanders in phase (``y`` less its phase-averaged ``periodic``
+    part): its partial sums stay bounded, so it adds to the window mean only at the window's
+    two ends, ``var(mean) = sigma^2/n + gamma/n^2`` (``sigma^2`` the long-run variance,
+    ``gamma = -2 sum_k k R_k``; Song & Schmeiser 1995, Management Sci. 41(1) 110), while
+    overlapping batch means of ``L`` samples (Meketon & Schmeiser 1984) count it at every
+    batch's two ends: ``E[var_L] = sigma^2/n + gamma/((n - L) L)`` to first order
+    (Aktaran-Kalayci et al. 2007, Naval Res. Logist. 54(4) 397). ``var_L`` at ``L`` = 1, 2,
+    ... whole pitches (so the fixed wave drops out of every batch) are fitted by
+    ``a + c/((n - L) L)`` with ``a, c >= 0`` (non-negative least squares), and
+    ``se^2 = a + c/n^2``. ``c >= 0``: the end effect of a wave; a positive correlation at long
+    lags (``c < 0``), inside a window the load cells' drift, is the zero-drift term's and is
+    not extrapolated here (unconstrained, it raised the virtual testbed's DP, load and R
+    coverage by 1.5-2.4 points on seed 101). On synthetic windows (tests) it is low by about
+    10 % in variance on white noise, where the fit drops a negative ``a``.
+    ``dof = 1.5 (n/pitch - 1)``: those of overlapping batch means of one pitch, where the fit
+    has most of its information (their variance 2/3 of non-overlapping batches', Meketon &
+    Schmeiser 1984). With two or three pitches (one value of ``(n - L) L``), the mean of
+    their ``var_L``: plain overlapping batch means. None with fewer than two pitches or a
+    pitch under 2 samples."""
+    y = np.asarray(y, float)
+    if periodic is not None:
+        y = y - np.nan_to_num(np.asarray(periodic, float))
+    y = y[np.isfinite(y)]
+    n, m = y.size, int(pitch)
+    if m < 2 or n < 2 * m:
+        return None
+    sizes = m * np.arange(1, max(n // m - 1, 1) + 1)
+    var = np.array([_obm_var(y, int(size)) for size in sizes])
+    x = 1.0 / ((n - sizes) * sizes)
+    estimate = float(var.mean())
+    if np.ptp(x) > 0:
+        (a, c), _ = optimize.nnls(np.column_stack([np.ones(x.size), x]), var)
+        estimate = a + c / n**2
+    return float(np.sqrt(estimate)), 1.5 * (n / m - 1.0)

@@ -9,11 +9,12 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   (``run_results.stats.batch_means_se``, Satterthwaite degrees of freedom) instead: the
   derivative filter's noise is anti-correlated at short lags, so the autocorrelation sum,
   which stops at the first negative pair, counts that noise in full and still ends before
-  a slow ripple of the drives is seen. With grousers every quantity's too, on the residual
-  about the phase-averaged wave: a real grouser wave wanders in phase (passage by passage)
-  and keeps ringing in that residual; summed, its autocorrelation's first positive lobes
-  count a wave that averages to zero over each pitch as noise, while batch means see only
-  what is left of it at zero frequency.
+  a slow ripple of the drives is seen (with grousers, on the residual about the
+  phase-averaged wave). The other grousered quantities' by whole-pitch overlapping batch
+  means with the wave's end effect separated (``run_results.stats.pitch_batch_means_se``):
+  a real grouser wave wanders in phase (passage by passage) but averages to zero over each
+  pitch, so it reaches the window mean only at the window's ends, while batch means count
+  it at every batch end.
 - ``zero_drift``: the load cells' zero at the window, from the rest readings
   (``run_results.rest_readings``). DP, torque and side force read zero at rest; the zero is
   taken as linear in time between the two rests and subtracted (the ``correction``, GUM
@@ -394,9 +395,9 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
                frequency_hz: float | None = None) -> tuple[dict[str, QuantityStats],
                                                            dict[str, QuantityBudget]]:
     """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
-    re-zeroing correction added (module doc); ``batches``: the batch-means
-    ``(se, dof)`` (``run_results.stats.batch_means_se``); ``frequency_hz``: the grouser
-    passing frequency (None: no grousers)."""
+    re-zeroing correction added (module doc); ``batches``: the batch-means ``(se, dof)``
+    (``run_results.stats.batch_means_se``, ``pitch_batch_means_se``); ``frequency_hz``: the
+    grouser passing frequency (None: no grousers)."""
     params = params or BudgetParams()
     batches = batches or {}
     budgets: dict[str, QuantityBudget] = {}
