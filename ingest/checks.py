@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -75,13 +76,13 @@ def check_calibrated(path: Path, where: str, column: str, values: np.ndarray) ->
     """A channel after calibration and zeroing: every sample finite and within the
     magnitude its quantity (or column) can have on a testbed (``swtlab.domain.ranges``);
     beyond it the gain, offset, zero or unit is wrong."""
-    bad = ~np.isfinite(values)
-    if bad.any():
-        raise IngestError(path, where, f"{int(bad.sum())} samples of {column} are NaN/inf after "
-                          "calibration and zeroing (gain, offset or zero overflows)")
+    peak = float(np.max(np.abs(values))) if values.size else 0.0  # NaN or inf: some are
+    if not math.isfinite(peak):
+        raise IngestError(path, where, f"{int((~np.isfinite(values)).sum())} samples of {column} "
+                          "are NaN/inf after calibration and zeroing (gain, offset or zero "
+                          "overflows)")
     quantity = column_quantity(column)
     limit = COLUMN_LIMITS.get(column, CHANNEL_LIMITS[quantity])
-    peak = float(np.max(np.abs(values))) if values.size else 0.0
     if peak > limit:
         raise IngestError(path, where, f"{column} reaches {peak:.3g} (SI) after calibration "
                           f"and zeroing, beyond any {quantity} a testbed measures ({limit:g}); "

@@ -11,6 +11,8 @@ import math
 import numpy as np
 from scipy.signal import savgol_filter
 
+from swtlab.order_stats import median
+
 #: relative error aimed at for a derivative at the stream's typical speed
 TARGET_REL_ERROR = 0.01
 WINDOW_MIN_S = 0.02
@@ -26,7 +28,10 @@ def quantisation_step(x: np.ndarray) -> float:
     Tries q = (smallest level spacing)/k for k = 1..1000; 0.0 when the levels are not
     on a lattice (a continuous signal, or steps far finer than the motion per sample).
     """
-    levels = np.unique(x)
+    if len(x) < 2:
+        return 0.0
+    levels = np.sort(x, kind="stable")  # np.unique's levels; an encoder's rising counts are
+    levels = levels[np.r_[True, levels[1:] != levels[:-1]]]  # one run for the stable sort
     spacing = np.diff(levels)
     spacing = spacing[spacing > 1e-12 * max(1.0, float(np.abs(levels).max(initial=0.0)))]
     if len(spacing) == 0:
@@ -48,7 +53,7 @@ def encoder_noise(t_s: np.ndarray, x: np.ndarray) -> dict:
     if len(x) > 2:
         w = (t_s[1:-1] - t_s[:-2]) / (t_s[2:] - t_s[:-2])
         residual = x[1:-1] - ((1 - w) * x[:-2] + w * x[2:])
-        noise = float(1.4826 * np.median(np.abs(residual - np.median(residual))) / math.sqrt(1.5))
+        noise = float(1.4826 * median(np.abs(residual - median(residual))) / math.sqrt(1.5))
     duration = float(t_s[-1] - t_s[0]) if len(t_s) > 1 else 0.0
     speed = abs(float(x[-1] - x[0])) / duration if duration > 0 else 0.0
     rate = (len(t_s) - 1) / duration if duration > 0 else None

@@ -18,15 +18,17 @@ def _column_unit(column: str) -> str:
     return _DERIVED_UNITS.get(column, "1")
 
 
+def stream_report(run: Run) -> list[dict]:
+    """Each stream's channels with rate/span/gaps/units, as plain data (what a processed run
+    stores; the rest of :func:`report` it does not need)."""
+    return jsonable([{"topic": topic, **run.timing[topic].to_dict(),
+                      "channels": [{"column": c, "unit": _column_unit(c),
+                                    "source_unit": run.units.get(c)} for c in frame.columns[1:]]}
+                     for topic, frame in run.streams.items()])
+
+
 def report(run: Run) -> dict:
     """Metadata, each stream's channels with rate/span/gaps/units, the time base and problems."""
-    streams = []
-    for topic, frame in run.streams.items():
-        timing = run.timing[topic]
-        streams.append({
-            "topic": topic, **timing.to_dict(),
-            "channels": [{"column": c, "unit": _column_unit(c),
-                          "source_unit": run.units.get(c)} for c in frame.columns[1:]]})
     table = run.channels
     columns = []
     for column in table.columns[1:]:
@@ -36,7 +38,7 @@ def report(run: Run) -> dict:
                         "valid_fraction": float(finite.mean()) if len(values) else 0.0,
                         "mean": float(values[finite].mean()) if finite.any() else None})
     return jsonable({"source": str(run.source), "channel_map": run.channel_map,
-                   "metadata": run.metadata.to_dict(), "streams": streams,
+                   "metadata": run.metadata.to_dict(), "streams": stream_report(run),
                    "time_base": run.derivation.get("time_base"), "channels": columns,
                    "frames": [f.to_dict() for f in run.frames.values()],
                    "derivation": run.derivation,

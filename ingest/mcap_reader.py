@@ -1,7 +1,8 @@
 """MCAP form reader (spec: "MCAP form"): JSON blocks of samples, metadata records, camera frames.
 
-One ``json.loads`` per block; samples are flattened per field with numpy, never
-one Python object per sample on our side.
+One ``orjson.loads`` per block, each field made an array at once (``_plain_blocks``); only a
+block that may hold more than numbers goes through the sample-by-sample checks
+(``_checked_blocks``), which name the first problem.
 """
 
 from __future__ import annotations
@@ -76,7 +77,55 @@ def _loads(message: bytes):
 
 
 def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
-    """Concatenate a topic's blocks (ordered by their first time stamp) into field arrays."""
+    """Concatenate a topic's blocks (ordered by their first time stamp) into field arrays:
+    :func:`_plain_blocks` when it can, else every sample checked (:func:`_checked_blocks`)."""
+    plain = _plain_blocks(data)
+    return plain if plain is not None else _checked_blocks(path, topic, data)
+
+
+def _plain_blocks(data: list[bytes]) -> RawTopic | None:
+    """The blocks decoded one at a time (each made arrays while its JSON is in the cache, as
+    the decode limit of ``bench/bench_ingest.py`` does); None at anything that is not a
+    well-formed block of numbers (and null as NaN) with whole-ns time stamps in range, which
+    :func:`_checked_blocks` then names. Same arrays as that path."""
+    columns: dict[str, list[np.ndarray]] = {}
+    for message in data:
+        try:
+            block = orjson.loads(message)
+        except orjson.JSONDecodeError:
+            return None
+        if type(block) is not dict or "t_ns" not in block or not (
+                _numbers_only(message, len(block)) and _whole_stamps(message)):
+            return None
+        if not columns:
+            columns = {name: [] for name in block}
+        elif block.keys() != columns.keys():
+            return None
+        try:
+            arrays = {name: np.array(v, np.int64 if name == "t_ns" else np.float64)
+                      for name, v in block.items()}
+        except (ValueError, TypeError, OverflowError):  # a list or null among the samples,
+            return None                                 # a number beyond int64/float64
+        size = arrays["t_ns"].shape
+        if len(size) != 1 or any(a.shape != size for a in arrays.values()):
+            return None
+        for name, values in arrays.items():
+            columns[name].append(values)
+    if not columns:
+        return None
+    stamps = columns.pop("t_ns")
+    big = np.iinfo(np.int64).max  # an empty block sorts last
+    order = np.argsort([s[0] if len(s) else big for s in stamps], kind="stable")
+    t_ns = np.concatenate([stamps[i] for i in order])
+    if t_ns.size and not (0 <= t_ns.min() and t_ns.max() <= MAX_T_NS):
+        return None
+    return RawTopic(t_s=t_ns * 1e-9, fields={name: np.concatenate([parts[i] for i in order])
+                                               for name, parts in columns.items()})
+
+
+def _checked_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
+    """:func:`_decode_blocks` with every block's structure and every sample's JSON type
+    checked, naming the first problem."""
     blocks = []
     for i, message in enumerate(data):
         try:
@@ -101,8 +150,7 @@ def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
                               "every field of a block must have one value per t_ns")
         lengths[i] = sizes["t_ns"]
     total = int(lengths.sum())
-    plain = all(map(_numbers_only, data, map(len, blocks)))
-    t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64, plain)
+    t_ns = _flatten(path, topic, "t_ns", blocks, total, np.int64)
     starts = np.concatenate([[0], np.cumsum(lengths)])
     firsts = np.full(len(blocks), np.iinfo(np.int64).max)  # an empty block sorts last
     firsts[lengths > 0] = t_ns[starts[:-1][lengths > 0]]
@@ -110,7 +158,7 @@ def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
     if (order != np.arange(len(blocks))).any():
         blocks = [blocks[i] for i in order]
         t_ns = np.concatenate([t_ns[starts[i]:starts[i + 1]] for i in order])
-    fields = {k: _flatten(path, topic, k, blocks, total, np.float64, plain)
+    fields = {k: _flatten(path, topic, k, blocks, total, np.float64)
               for k in names if k != "t_ns"}
     return RawTopic(t_s=t_ns * 1e-9, fields=fields)
 
@@ -128,6 +176,19 @@ def _numbers_only(message: bytes, keys: int) -> bool:
     return rest.count(b'"') == 2 * keys and b"tru" not in rest and b"fals" not in rest
 
 
+#: the bytes of the whole numbers a t_ns list holds, and of the JSON around them
+_WHOLE_BYTES = b"0123456789-:,[ \t\r\n"
+
+
+def _whole_stamps(message: bytes) -> bool:
+    """Whether a plain block's t_ns list (up to its first ``]``) has no decimal point,
+    exponent or null: whole numbers, which int64 takes as they are (a list nested in it
+    fails the conversion or the shape check)."""
+    start = message.find(b'"t_ns"')  # not found: a key spelt with escapes
+    stop = message.find(b"]", start)
+    return 0 <= start < stop and not message[start + 6:stop].translate(None, _WHOLE_BYTES)
+
+
 #: JSON types a sample may have: numbers, and null (how many writers spell NaN)
 _SAMPLE_TYPES = {int, float, type(None)}
 #: time stamps: whole nanoseconds from the run start, at most this many (a century)
@@ -135,35 +196,10 @@ MAX_T_NS = 100 * 365 * 86400 * 10**9
 
 
 def _flatten(path: Path, topic: str, name: str, blocks: list[dict], total: int,
-             dtype: type, plain: bool = False) -> np.ndarray:
-    """One field of every block as one array. A sample that is not a JSON number or null
-    (true/false, a numeric string, a list) is an error, not converted; a time stamp must be a
-    whole number of ns in ``0..MAX_T_NS``; a number beyond float64 is an error.
-
-    ``plain``: the blocks' JSON holds no string sample and no ``true``/``false``
-    (:func:`_numbers_only`), so the samples are numbers, null or lists: converted in one
-    pass, and anything that pass refuses (a list, a huge number, a time stamp that is not a
-    whole number) goes through the sample-by-sample checks of :func:`_checked`, which
-    convert the same numbers to the same values and name the problem."""
-    if plain and dtype is np.float64:
-        try:  # null -> NaN, as below; a list or a number beyond float64 raises
-            return np.fromiter(chain.from_iterable(b[name] for b in blocks), np.float64,
-                               count=total)
-        except (ValueError, TypeError, OverflowError):
-            pass
-    values = list(chain.from_iterable(b[name] for b in blocks))
-    if plain:  # time stamps: their sum stays an int only if every one is (no bool: plain)
-        try:
-            found = np.fromiter(values, np.int64, count=total) \
-                if type(sum(values)) is int else None
-        except (TypeError, OverflowError):  # a null or a list; beyond int64
-            found = None
-        if found is not None:
-            if found.size and not (0 <= found.min() and found.max() <= MAX_T_NS):
-                raise IngestError(path, f"{topic}.{name}", f"time stamps outside "
-                                  f"0..{MAX_T_NS} ns (t_ns counts ns from the run start)")
-            return found
-    return _checked(path, topic, name, values, total, dtype)
+             dtype: type) -> np.ndarray:
+    """One field of every block as one array, each sample checked (:func:`_checked`)."""
+    return _checked(path, topic, name, list(chain.from_iterable(b[name] for b in blocks)),
+                    total, dtype)
 
 
 def _checked(path: Path, topic: str, name: str, values: list, total: int,

@@ -73,11 +73,13 @@ def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = N
     metadata, meta_problems = parse_metadata(path, records,
                                              needs_suspension="suspension_angle_rad" in provided)
     problems += meta_problems
-    streams, units = _streams(raw, cmap, metadata, problems)
-    timing = {topic: stream_timing(frame["t_s"].to_numpy()) for topic, frame in streams.items()}
+    arrays, units = _streams(raw, cmap, metadata, problems)
+    timing = {topic: stream_timing(columns["t_s"]) for topic, columns in arrays.items()}
     _check_clocks(path, timing)
     problems += _timing_problems(timing)
-    channels, derivation = _channel_table(streams, timing, metadata, provided, problems)
+    channels, derivation = _channel_table(arrays, timing, metadata, provided, problems)
+    streams = {topic: pd.DataFrame(columns, copy=False)  # their own arrays: no copy
+               for topic, columns in arrays.items()}
     problems += _frame_problems(raw.frames, metadata)
     return Run(source=path, metadata=metadata, streams=streams, channels=channels,
                problems=problems, derivation=derivation, frames=raw.frames, timing=timing,
@@ -121,8 +123,8 @@ def _coverage_problems(path: Path, raw: RawRun, cmap: ChannelMap) -> list[Proble
 
 
 def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
-             problems: list[Problem]) -> tuple[dict[str, pd.DataFrame], dict[str, str]]:
-    """Per topic: native t_s + calibrated, zeroed canonical SI columns."""
+             problems: list[Problem]) -> tuple[dict[str, dict[str, np.ndarray]], dict[str, str]]:
+    """Per topic: native t_s + calibrated, zeroed canonical SI columns (arrays by name)."""
     streams, units = {}, {}
     used = set()
     for topic in cmap.topics:
@@ -142,7 +144,7 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
             check_calibrated(raw.path, f"{topic}.{spec.field}", spec.column, values)
             columns[spec.column] = values
             units[spec.column] = spec.unit if cal is None else "SI (swt.calibration)"
-        streams[topic] = pd.DataFrame(columns, copy=False)  # its own arrays: no copy
+        streams[topic] = columns
     for topic, fld in sorted(set(metadata.calibration) - used):
         problems.append(Problem("warning", f"{topic}.{fld}",
                                 "swt.calibration names a channel this run does not have"))
@@ -188,14 +190,15 @@ def _timing_problems(timing: dict[str, StreamTiming]) -> list[Problem]:
 
 def _channel_table(streams, timing, metadata: RunMetadata, provided: set[str],
                    problems: list[Problem]) -> tuple[pd.DataFrame, dict]:
-    """Every stream onto one uniform grid, then the derived signals on it."""
+    """Every stream (arrays by column) onto one uniform grid, then the derived signals on it."""
     grid, rate = common_grid(list(timing.values()))
     table: dict[str, np.ndarray] = {"t_s": grid}
-    for topic, frame in streams.items():
-        t = frame["t_s"].to_numpy()
+    for topic, columns in streams.items():
+        t = columns["t_s"]
         mask = grid_mask(t, timing[topic], grid)
-        for column in frame.columns[1:]:
-            table[column] = to_grid(t, frame[column].to_numpy(), grid, mask)
+        for column, values in columns.items():
+            if column != "t_s":
+                table[column] = to_grid(t, values, grid, mask)
     derivation: dict = {"time_base": {
         "rate_hz": rate, "t0_s": float(grid[0]), "samples": len(grid),
         "method": "uniform grid at the fastest stream's median rate (capped at 1000 Hz); "
@@ -204,7 +207,8 @@ def _channel_table(streams, timing, metadata: RunMetadata, provided: set[str],
     _derive_rates(table, streams, rate, metadata, provided, derivation)
     _derive_heights(table, metadata, provided, derivation, problems)
     for column in CANONICAL + DERIVED:
-        table.setdefault(column, np.full(len(grid), np.nan))
+        if column not in table:
+            table[column] = np.full(len(grid), np.nan)
     order = ["t_s", *CANONICAL, *(c for c in DERIVED if c not in CANONICAL)]
     order += sorted(set(table) - set(order))  # extra columns a channel map adds
     return pd.DataFrame({c: table[c] for c in order}, copy=False), derivation  # arrays made here
@@ -219,8 +223,8 @@ def _derive_rates(table, streams, rate, metadata, provided, derivation) -> None:
             continue
         if position not in provided:
             continue
-        frame = next(f for f in streams.values() if position in f.columns)
-        stats = derive.encoder_noise(frame["t_s"].to_numpy(), frame[position].to_numpy())
+        columns = next(c for c in streams.values() if position in c)
+        stats = derive.encoder_noise(columns["t_s"], columns[position])
         window_s = derive.choose_window_s(stats)
         table[rate_column], window = derive.savgol_derivative(table[position], rate, window_s)
         derivation[rate_column] = {

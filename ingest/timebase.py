@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swtlab.order_stats import median as _median
+
 #: an interval longer than GAP_FACTOR median intervals is a gap (no interpolation across it)
 GAP_FACTOR = 5.0
 #: intervals between DROP_FACTOR and GAP_FACTOR median intervals are dropped samples
@@ -47,7 +49,7 @@ def stream_timing(t_s: np.ndarray) -> StreamTiming:
     if len(t_s) < 2:
         return StreamTiming(len(t_s), float(t_s[0]), float(t_s[-1]), float("nan"), (), 0, 0.0)
     dt = np.diff(t_s)
-    median = float(np.median(dt))
+    median = _median(dt)
     ratio = dt / median
     gap_idx = np.flatnonzero(ratio > GAP_FACTOR)
     drop = ratio[(ratio > DROP_FACTOR) & (ratio <= GAP_FACTOR)]

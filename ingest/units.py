@@ -78,6 +78,8 @@ def column_quantity(column: str) -> str:
 
 
 def to_si(values: np.ndarray, unit: Unit) -> np.ndarray:
-    """Values in ``unit`` converted to SI (a new float64 array)."""
-    out = np.asarray(values, dtype=np.float64) * unit.factor
+    """Values in ``unit`` converted to SI (float64; the values themselves when already SI)."""
+    out = np.asarray(values, dtype=np.float64)
+    if unit.factor != 1.0:
+        out = out * unit.factor
     return out + unit.offset if unit.offset else out

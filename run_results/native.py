@@ -38,11 +38,16 @@ SINGLE_CHANNEL = {"wheel_load_n": ("fz_n", False), "dp_n": ("dp_n", False),
 
 
 def channel_samples(run, column: str, start_s: float, end_s: float):
+    """``(t_s, values)`` of ``column``'s native samples from ``start_s`` to ``end_s``
+    (inclusive, finite values only), or None. The stream's ``t_s`` ascend (ingest refuses
+    others), so the window is one slice found by bisection."""
     for frame in run.streams.values():
         if column in frame.columns:
-            t = frame["t_s"].to_numpy()
-            inside = (t >= start_s) & (t <= end_s) & np.isfinite(frame[column].to_numpy())
-            return t[inside], frame[column].to_numpy()[inside]
+            t, y = frame["t_s"].to_numpy(), frame[column].to_numpy()
+            lo, hi = np.searchsorted(t, start_s, "left"), np.searchsorted(t, end_s, "right")
+            t, y = (t[lo:hi], y[lo:hi]) if start_s <= end_s else (t[:0], y[:0])  # NaN: none
+            finite = np.isfinite(y)
+            return (t, y) if finite.all() else (t[finite], y[finite])
     return None
 
 

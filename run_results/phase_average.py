@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from swtlab.order_stats import median
+
 MIN_BINS, MAX_BINS = 4, 256
 
 
@@ -26,7 +28,7 @@ def phase_average(t_s, y, frequency_hz: float) -> dict:
     ``bins``."""
     t_s, y = np.asarray(t_s, float), np.asarray(y, float)
     ok = np.isfinite(y)
-    dt = float(np.median(np.diff(t_s))) if t_s.size > 1 else 1.0
+    dt = median(np.diff(t_s)) if t_s.size > 1 else 1.0
     bins = bin_count(1.0 / (frequency_hz * dt))
     index = np.minimum((np.mod(frequency_hz * (t_s - t_s[0]), 1.0) * bins).astype(int), bins - 1)
     sums = np.bincount(index[ok], y[ok], minlength=bins)

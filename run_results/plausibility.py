@@ -29,6 +29,7 @@ from ingest.canonical import WRENCH_COLUMNS
 from run_results.native import channel_samples, hub_samples
 from stable_phase.signals import grouser_period_s, moving_average
 from swtlab.domain.ranges import METADATA, WHEEL_KEYS
+from swtlab.order_stats import median
 
 #: force and torque channels checked for saturation
 RAIL_CHANNELS = (*WRENCH_COLUMNS.values(), "dp_n")
@@ -99,13 +100,13 @@ def spike_flags(run, start_s: float, end_s: float) -> list[str]:
     flags = []
     for column, y in _window_samples(run, start_s, end_s):
         scale = SPIKE_LOAD_RATIO * load * (radius if column.endswith("_nm") else 1.0)
-        jumps = int(np.sum(np.abs(y - np.median(y)) > scale)) if y.size else 0
+        jumps = int(np.sum(np.abs(y - median(y)) > scale)) if y.size else 0
         if jumps:
             flags.append(f"{column}: {jumps} samples jump more than {scale:.4g} from the window's "
                          f"median ({SPIKE_LOAD_RATIO:g} x the set load): electrical spikes?")
     hub = hub_samples(run, start_s, end_s)
     if hub is not None and hub[1].size:
-        jumps = int(np.sum(np.abs(hub[1] - np.median(hub[1])) > radius))
+        jumps = int(np.sum(np.abs(hub[1] - median(hub[1])) > radius))
         if jumps:
             flags.append(f"hub_height_m: {jumps} samples jump more than the wheel radius "
                          f"{radius:g} m from the window's median: arm encoder spikes?")

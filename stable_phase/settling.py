@@ -29,6 +29,7 @@ from scipy.optimize import curve_fit
 from stable_phase.mser import MserDetector, batch_means, mser_two_sided
 from stable_phase.registry import Cut, register
 from stable_phase.signals import moving_average
+from swtlab.order_stats import median
 
 MIN_SNR = 10.0
 #: the smoothed signals are fitted on at most this many points (decimated after the
@@ -72,7 +73,7 @@ def fit_settling(t_s: np.ndarray, y: np.ndarray, double_pole: bool = True) -> di
         return None
     t, y = t_s[ok] - t_s[0], y[ok]
     span = float(t[-1])
-    a0 = float(np.median(y[t >= 0.75 * span]))
+    a0 = median(y[t >= 0.75 * span])
     plain = _fit(_exponential, t, y, (a0, float(y[0] - a0), span / 10.0, 0.0),
                  [-np.inf, -np.inf, 1e-3 * span, 0.0], [np.inf, np.inf, 2.0 * span, 0.5 * span])
     if plain is None:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from swtlab.order_stats import median
+
 
 def moving_average(x, width: int, full_only: bool = False) -> np.ndarray:
     """Centred NaN-aware moving average over ``width`` samples (NaN where no sample is finite;
@@ -46,7 +48,7 @@ def robust_sigma(x) -> float:
     x = x[np.isfinite(x)]
     if x.size == 0:
         return float("nan")
-    return float(1.4826 * np.median(np.abs(x - np.median(x))))
+    return float(1.4826 * median(np.abs(x - median(x))))
 
 
 def decimate_mean(t, x, max_points: int) -> tuple[np.ndarray, np.ndarray]:

@@ -233,3 +233,30 @@ def test_blocks_decode_the_same_on_the_one_pass_and_the_checked_path():
         np.testing.assert_array_equal(topic.t_s, np.array([0, 10, 20]) * 1e-9)  # t_ns 1e-9
         np.testing.assert_array_equal(topic.fields[key], [1.5, np.nan, 2.0])
         assert topic.fields[key].dtype == np.float64
+
+
+@pytest.mark.parametrize("blocks, plain", [
+    ([b'{"t_ns": [5, 9], "fz": [1, 2.5]}', b'{"t_ns": [], "fz": []}',
+      b'{"t_ns": [0], "fz": [null]}'], True),
+    ([b'{"t_\\u006es": [0, 10], "fz": [1.5, 2]}'], False),  # a key spelt with an escape
+    ([b'{"t_ns": [0, 1e3], "fz": [1.5, 2]}'], False),       # an exponent: the checks say
+    ([b'{"t_ns": [[0], [10]], "fz": [1.5, 2]}'], False)])   # nested stamps
+def test_blocks_one_at_a_time_decode_as_the_checked_path_or_leave_it_to_it(blocks, plain):
+    """The per-block pass gives the checked path's arrays, or declines (None) and lets the
+    checked path decode or name the problem."""
+    from ingest.errors import IngestError
+    from ingest.mcap_reader import _checked_blocks, _plain_blocks
+
+    fast = _plain_blocks(blocks)
+    assert (fast is not None) == plain
+    try:
+        checked = _checked_blocks(Path("run.mcap"), "/hub/wrench", blocks)
+    except IngestError as exc:
+        assert not plain and "t_ns" in exc.channel
+        return
+    if fast is not None:
+        np.testing.assert_array_equal(fast.t_s, checked.t_s)
+        assert fast.fields.keys() == checked.fields.keys()
+        for name, values in checked.fields.items():
+            np.testing.assert_array_equal(fast.fields[name], values)
+            assert fast.fields[name].dtype == values.dtype == np.float64

@@ -111,7 +111,7 @@ def process_file(path: Path, settings: ProcessSettings,
     Linear algebra runs on one thread (the arrays are small: several BLAS threads per run
     only contend, with each other and with the other runs' workers)."""
     import ingest
-    from ingest.inspect_report import report
+    from ingest.inspect_report import stream_report
     from run_results import process_run
     from softflow.track_run import run_image_slip
     from threadpoolctl import threadpool_limits
@@ -123,7 +123,7 @@ def process_file(path: Path, settings: ProcessSettings,
         try:
             done.sha256, done.size_bytes = content or content_sha256(path)
             done.run = ingest.read_run(path, channel_map=settings.channel_map)
-            done.streams = report(done.run)["streams"]
+            done.streams = stream_report(done.run)
         except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
             done.run = None
             done.failures.append(Failure.of(path, "ingest", error))
