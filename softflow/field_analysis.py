@@ -3,7 +3,8 @@
 Pipeline (issue items 2-5): track the wheel (:mod:`softflow.wheel_detect`), mask it,
 measure and average the soil flow (:mod:`softflow.flow_engine`), go to the world
 frame and resolve about the axle (:mod:`softflow.polar`), fit ``k(beta)`` and
-``alpha3(beta)`` (:mod:`softflow.decay_fit`), and for a grousered wheel score the
+``alpha3(beta)`` (:mod:`softflow.decay_fit`; their CIs by a jackknife over the frame pairs,
+:func:`jackknife_ci`), and for a grousered wheel score the
 effective-radius models (:mod:`softflow.grouser_models`). ``eps_vol^P(beta)`` is
 given or estimated from the measured field (:mod:`softflow.volumetric_strain`), and
 ``1/k = eps/alpha1 + alpha2/alpha1`` is regressed over beta (alpha1, alpha2
