@@ -29,10 +29,10 @@ def rates_and_sigmas(fits: Sequence[DecayFit | None]) -> tuple[np.ndarray, np.nd
     k = np.full(len(fits), np.nan)
     sigma = np.full(len(fits), np.nan)
     for i, f in enumerate(fits):
-        if f and f.r2 > MIN_R2 and f.rate_per_m > 0 and f.points > 2:
+        if f and f.r2 > MIN_R2 and f.rate_per_m > 0 and f.dof > 0:
             k[i] = f.rate_per_m
             half = (f.ci95_per_m[1] - f.ci95_per_m[0]) / 2
-            sigma[i] = half / stats.t.ppf(0.975, f.points - 2)
+            sigma[i] = half / stats.t.ppf(0.975, f.dof)
     return k, sigma
 
 

@@ -3,7 +3,9 @@
 ``rho = r - R`` the distance from the rim (m). Weighted nonlinear least squares
 (scipy ``curve_fit``, started from a log-linear fit); the 95 % confidence interval
 of ``k`` is ``k +- t(0.975, n-2) * sigma_k`` from the scaled covariance; R² of the
-weighted fit. This gives ``alpha3(beta)`` (tangential) and ``k(beta) =
+weighted fit. That CI holds the scatter about one profile only;
+:func:`softflow.field_analysis.jackknife_ci` replaces it by the scatter over frame pairs
+(``ci_dof`` then the pairs less one). This gives ``alpha3(beta)`` (tangential) and ``k(beta) =
 alpha1 / (eps_vol^P + alpha2)`` (radial) of the SOFT velocity-field model.
 """
 
@@ -22,10 +24,16 @@ class DecayFit:
     ci95_per_m: tuple[float, float]
     r2: float
     points: int
+    ci_dof: int | None = None  # degrees of freedom of the CI's t quantile; None: points - 2
+
+    @property
+    def dof(self) -> int:
+        return self.points - 2 if self.ci_dof is None else self.ci_dof
 
     def to_dict(self) -> dict:
         return {"amplitude_mps": self.amplitude, "rate_per_m": self.rate_per_m,
-                "ci95_per_m": list(self.ci95_per_m), "r2": self.r2, "points": self.points}
+                "ci95_per_m": list(self.ci95_per_m), "ci95_dof": self.dof, "r2": self.r2,
+                "points": self.points}
 
 
 def _model(rho, a, k):

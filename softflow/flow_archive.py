@@ -52,7 +52,7 @@ def _fit(d: dict | None) -> DecayFit | None:
         return None
     ci = tuple(np.nan if v is None else v for v in d["ci95_per_m"])
     return DecayFit(d["amplitude_mps"], d["rate_per_m"], ci,
-                    np.nan if d["r2"] is None else d["r2"], d["points"])
+                    np.nan if d["r2"] is None else d["r2"], d["points"], d.get("ci95_dof"))
 
 
 def _profiles(z, c: str, step: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:

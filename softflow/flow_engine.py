@@ -51,6 +51,9 @@ Outliers: normalised median test of Westerweel & Scarano (2005, "Universal outli
 detection for PIV data"), on neighbours ``spacing_px`` apart, ``eps = 0.1 px``,
 threshold 2. Vectors within ``BORDER_PX`` of the image border are rejected (biased low: the
 warp samples beyond the image). Valid vectors of all pairs are averaged per pixel.
+The flows of the decay-rate analysis (:func:`average_flow`) are taken on frames smoothed by a
+Gaussian of ``RATE_PRESMOOTH_PX`` (both frames alike, so a shift is unchanged), which damps
+JPEG blocking and sensor noise: numbers at the constant.
 """
 
 from __future__ import annotations
@@ -78,6 +81,13 @@ DIS_PRESET = cv2.DISOPTICAL_FLOW_PRESET_ULTRAFAST
 #: renderer (tuning seeds 400, 401, 5 pairs): the speed 2.4 % of V low within 3 px of the
 #: border, 1.0 % at 3-6 px, 0.5 % at 6-9 px, 0.3 % (uniform, the whole field's scale) beyond
 BORDER_PX = 8
+#: Gaussian sigma (px) of the frames' smoothing before the decay-rate flows (average_flow).
+#: Set on the second renderer (JPEG q80, blur, noise; tuning seed 400): one pair's error
+#: 0.075 px RMS unsmoothed, 0.063 at 0.6-0.8 px, 0.070 at 1.3 px; seeds 400-405, 12 frames:
+#: k / alpha3 within 5 % in 78 % / 85 % of the defined contact bins -> 88 % / 93 %. The
+#: first renderer's (noise 2 grey levels, no JPEG) pair error 0.0243 -> 0.0252 px (seeds 400,
+#: 401), so the displacement engine itself (pair_displacement_px) does not smooth by default
+RATE_PRESMOOTH_PX = 0.7
 
 
 @numba.njit(parallel=True, cache=True)
@@ -243,14 +253,19 @@ def _deform_lk(a: np.ndarray, b: np.ndarray, soil: np.ndarray,
 @capped
 def pair_displacement_px(frame_a: np.ndarray, frame_b: np.ndarray, engine: str = "deform-lk",
                          soil: np.ndarray | None = None,
-                         windows: tuple[int, ...] = ICI_KERNELS_PX) -> np.ndarray:
+                         windows: tuple[int, ...] = ICI_KERNELS_PX,
+                         presmooth_px: float = 0.0) -> np.ndarray:
     """Displacement (H, W, 2) = (dx, dy) in pixels of each frame-a pixel into frame b.
 
     ``soil`` (bool, H x W), when given, keeps wheel pixels out of the windows.
+    ``presmooth_px``: sigma of a Gaussian both frames are smoothed by first (0: none).
     ``windows``: stack-blur sizes in grid points of the last ``deform-lk`` pass; several:
     chosen per pixel by ICI (least displacement error), one: that window everywhere.
     """
     soil_f = np.ones(frame_a.shape, np.float32) if soil is None else soil.astype(np.float32)
+    if presmooth_px > 0:
+        frame_a, frame_b = (cv2.GaussianBlur(np.asarray(f, np.float32), (0, 0), presmooth_px)
+                            for f in (frame_a, frame_b))
     a, b = normalise_frames((frame_a, frame_b), soil_f)
     if engine == "farneback":
         return cv2.calcOpticalFlowFarneback(_to_uint8(a), _to_uint8(b), None, 0.5, 3, 21, 5, 5,
@@ -304,17 +319,19 @@ class MeanField:
 def _pair_flows(frames: list[np.ndarray], soil_masks: list[np.ndarray], engine: str,
                 client=None):
     """:func:`pair_displacement_px` of each consecutive pair (fixed window
-    ``RATE_KERNELS_PX``) in pair order: here, or on the workers of the ``dask.distributed``
-    ``client`` (each frame sent once; ``swtlab.cluster.map_in_order``)."""
+    ``RATE_KERNELS_PX``, frames smoothed by ``RATE_PRESMOOTH_PX``) in pair order: here, or on
+    the workers of the ``dask.distributed`` ``client`` (each frame sent once;
+    ``swtlab.cluster.map_in_order``)."""
     n = len(frames) - 1
     if client is None:
         return (pair_displacement_px(frames[k], frames[k + 1], engine, soil_masks[k],
-                                     RATE_KERNELS_PX) for k in range(n))
+                                     RATE_KERNELS_PX, RATE_PRESMOOTH_PX) for k in range(n))
     from swtlab.cluster import map_in_order
 
     sent = client.scatter(list(frames))
     return map_in_order(client, pair_displacement_px, sent[:-1], sent[1:], [engine] * n,
-                        client.scatter(list(soil_masks[:n])), [RATE_KERNELS_PX] * n)
+                        client.scatter(list(soil_masks[:n])), [RATE_KERNELS_PX] * n,
+                        [RATE_PRESMOOTH_PX] * n)
 
 
 def average_flow(frames: list[np.ndarray], t_s: np.ndarray, soil_masks: list[np.ndarray],

@@ -71,28 +71,35 @@ def profiles(component: np.ndarray, radius_px: np.ndarray, beta: np.ndarray,
     and its median is the velocity off the bin centre (on the second renderer's exact field,
     ``k`` 5 % low where the image bottom cut the ray).
     """
+    n_bins = len(beta_centres)
+    if not np.isclose(n_bins * width_rad, 2 * np.pi):
+        raise ValueError(f"{n_bins} beta bins of {np.rad2deg(width_rad):g} deg do not cover "
+                         "the circle")
     ok = np.isfinite(component) & (radius_px >= r_min_px)
+    r, v, angle = radius_px[ok], component[ok], beta[ok]
+    b = np.rint((angle - beta_centres[0]) / width_rad).astype(int) % n_bins
+    off = np.angle(np.exp(1j * (angle - beta_centres[b])))
+    idx = ((r - r_min_px) // step_px).astype(int)
+    rows = int(idx.max()) + 1 if len(idx) else 1
+    key = b * rows + idx  # one group per (beta bin, r bin), sorted by value within it
+    order = np.lexsort((v, key))
+    key, v, off = key[order], v[order], off[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]]) if len(key) else np.empty(0, int)
+    n = np.diff(np.r_[starts, len(key)])
+    lo, hi = starts + (n - 1) // 2, starts + n // 2  # the middle one or two of each group
+    med = (v[lo] + v[hi]) / 2
+    dev = np.abs(v - np.repeat(med, n))
+    dev = dev[np.lexsort((dev, key))]
+    mad = (dev[lo] + dev[hi]) / 2
+    mean_off = np.add.reduceat(off, starts) / n if len(starts) else np.empty(0)
+    group_bin, group_r = np.divmod(key[starts], rows)
+    rc = r_min_px + (group_r + 0.5) * step_px
+    keep = (n >= 10) & (n >= MIN_WEDGE_FILL * rc * step_px * width_rad) \
+        & (np.abs(mean_off) <= MAX_WEDGE_OFFSET * width_rad)
+    se = 1.4826 * mad / np.sqrt(np.maximum(n / 25, 1)) + 1e-9
+    enough = np.bincount(b, minlength=n_bins) >= 50
     out = []
-    for b in beta_centres:
-        offset = np.angle(np.exp(1j * (beta - b)))
-        sel = ok & (np.abs(offset) <= width_rad / 2)
-        r, v, off = radius_px[sel], component[sel], offset[sel]
-        if len(r) < 50:
-            out.append((np.empty(0), np.empty(0), np.empty(0)))
-            continue
-        idx = ((r - r_min_px) // step_px).astype(int)
-        order = np.argsort(idx, kind="stable")
-        idx, v, off = idx[order], v[order], off[order]
-        starts = np.flatnonzero(np.r_[True, idx[1:] != idx[:-1]])
-        groups = np.split(v, starts[1:])
-        n = np.array([len(g) for g in groups])
-        mean_off = np.add.reduceat(off, starts) / n
-        med = np.array([np.median(g) for g in groups])
-        mad = np.array([np.median(np.abs(g - m)) for g, m in zip(groups, med)])
-        rc = r_min_px + (idx[starts] + 0.5) * step_px
-        full = (n >= MIN_WEDGE_FILL * rc * step_px * width_rad) \
-            & (np.abs(mean_off) <= MAX_WEDGE_OFFSET * width_rad)
-        keep = (n >= 10) & full
-        se = 1.4826 * mad / np.sqrt(np.maximum(n / 25, 1)) + 1e-9
-        out.append((rc[keep], med[keep], se[keep]))
+    for j in range(n_bins):
+        sel = keep & (group_bin == j) if enough[j] else np.zeros(len(keep), bool)
+        out.append((rc[sel], med[sel], se[sel]))
     return out
