@@ -53,6 +53,12 @@ def paired_z(worse: np.ndarray, better: np.ndarray) -> float:
     return float(mean / se)
 
 
+def gain(worse: np.ndarray, better: np.ndarray) -> float:
+    """Share of the held-out loss of ``worse`` that ``better`` removes (0 when ``worse`` has
+    none)."""
+    return 1.0 - better.mean() / worse.mean() if worse.mean() > 0 else 0.0
+
+
 def rank(results: dict[str, CrossValidated], n_points: int) -> list[dict]:
     """Candidates sorted by held-out loss, each with its score, AICc, parameters and its
     paired z against the best."""
@@ -94,20 +100,20 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
     soil = losses["soil_only"]
     mine = losses[chosen["label"]]
     z_soil = paired_z(soil, mine)
-    gain = 1.0 - mine.mean() / soil.mean() if soil.mean() > 0 else 0.0
-    out = {"chosen": chosen["label"], "z_vs_soil_only": z_soil, "gain_vs_soil_only": gain}
+    gain_soil = gain(soil, mine)
+    out = {"chosen": chosen["label"], "z_vs_soil_only": z_soil, "gain_vs_soil_only": gain_soil}
     if rivals:
         rival = min(rivals, key=lambda c: c["held_out_loss"])
         return {**out, "verdict": "inconclusive", "leaders": [chosen["label"], rival["label"]],
                 "reason": f"{chosen['label']} and {rival['label']} explain the held-out data "
                           f"equally well (paired difference {rival['z_vs_best']:.1f} SE "
                           "from the best)"}
-    if chosen["effects"] and (z_soil < Z_CONFIDENT or gain < MIN_GAIN):
+    if chosen["effects"] and (z_soil < Z_CONFIDENT or gain_soil < MIN_GAIN):
         return {**out, "verdict": "inconclusive", "leaders": [chosen["label"], "soil_only"],
                 "reason": f"{chosen['label']} improves on soil-only recalibration by only "
-                          f"{z_soil:.1f} SE ({100 * gain:.0f} % of the held-out loss)"}
+                          f"{z_soil:.1f} SE ({100 * gain_soil:.0f} % of the held-out loss)"}
     for label in _nested(chosen["effects"]):
-        z, g = paired_z(losses[label], mine), 1.0 - mine.mean() / losses[label].mean()
+        z, g = paired_z(losses[label], mine), gain(losses[label], mine)
         if z < Z_CONFIDENT or g < MIN_GAIN:
             extra = next(e for e in chosen["effects"] if e not in label.split("+"))
             return {**out, "verdict": "inconclusive", "leaders": [chosen["label"], label],
@@ -123,7 +129,7 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
             "reason": "no missing effect: soil recalibration explains the data"
                       if not chosen["effects"] else
                       f"{chosen['label']} beats soil-only recalibration by {z_soil:.1f} SE "
-                      f"({100 * gain:.0f} % of the held-out loss)"
+                      f"({100 * gain_soil:.0f} % of the held-out loss)"
                       + (f", each of its singles by at least {Z_CONFIDENT:g} SE"
                          if len(chosen["effects"]) > 1 else "")
                       + f", and every rival of the same size by more than {Z_TIE:g} SE"}
