@@ -13,9 +13,10 @@ import pandas as pd
 from sim_gap import candidates as cands
 from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
 from sim_gap.aliasing import SEPARATING_RUN, aliasing_problem
+from sim_gap.contrast_check import contrast_problem
 from sim_gap.decide import rank, unless
 from sim_gap.discriminate import separating_test
-from sim_gap.fit import quantities_of, sigmas
+from sim_gap.fit import quantities_of, sigmas, standardised_residuals
 from sim_gap.identify import identification_problem
 from sim_gap.laws import reference_laws, robust_decide
 from sim_gap.regions import largest_gap, residual_map
@@ -121,6 +122,9 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     decision = unless(decision, aliasing_problem(
         points, sim.model.wheel, list(chosen.candidate.effects),
         dict(zip(chosen.candidate.effects, chosen.candidate.laws)), chosen.values), "aliased")
+    decision = unless(decision, contrast_problem(
+        points, standardised_residuals(points, sim.predict(points, chosen.values), sig),
+        list(chosen.candidate.effects)), "level_contrast")
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
                                "out: " + ", ".join(sorted(untestable)))

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim_gap.crossval import CrossValidated
-from sim_gap.decide import MIN_GAIN, Z_CONFIDENT, decide, paired_z, rank
+from sim_gap.decide import MIN_GAIN, Z_CONFIDENT, decide, gain, paired_z, rank
 
 
 def reference_laws(singles: dict[str, CrossValidated], n_points: int) -> dict[str, str]:
@@ -81,8 +81,8 @@ def robust_decide(results: dict[str, CrossValidated], allowed: dict[str, tuple[s
     ref = tried[0]
     for t in tried:
         t["z_best_vs_reference"] = paired_z(t["best"], ref["best"]) if t is not ref else 0.0
-        gain = 1.0 - ref["best"].mean() / t["best"].mean() if t["best"].mean() > 0 else 0.0
-        t["refuted"] = t["z_best_vs_reference"] >= Z_CONFIDENT and gain >= MIN_GAIN
+        t["refuted"] = (t["z_best_vs_reference"] >= Z_CONFIDENT
+                        and gain(t["best"], ref["best"]) >= MIN_GAIN)
     disagree = [t for t in tried[1:] if not t["refuted"] and (
         t["verdict"] != ref["verdict"] or t["verdict"] == "inconclusive")]
     sensitivity = {

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from terramechanics import slip_soil_ding2015, stress
-from terramechanics.effects import EFFECTS, LAWS, Effect, make_effect
+from terramechanics.effects import EFFECTS, LAWS, SOIL_ORDER, Effect, make_effect
 from terramechanics.equilibrium import solve_increasing
 from terramechanics.soil import SoilParams
 from terramechanics.state import (EARTH_GRAVITY_MPS2, Condition, Contact, Geometry,
@@ -126,8 +126,9 @@ class WheelModel:
             raise ValueError("slip must be >= -1 (a locked wheel)")
         cond = Condition(*(a.copy() for a in arrays))
         soil, geo = self._soil_state(cond), self._base_geometry(cond)
-        for effect in self.effects.values():
-            soil = effect.soil(soil, cond, self.wheel)
+        for name in SOIL_ORDER:
+            if name in self.effects:
+                soil = self.effects[name].soil(soil, cond, self.wheel)
         for effect in self.effects.values():  # geometry sees the soil all effects made
             geo = effect.geometry(geo, soil, cond, self.wheel)
         contact_forces = _ContactForces(soil, geo, cond)

@@ -184,6 +184,24 @@ def test_scm_multipass_reloads_elastically():
     np.testing.assert_allclose(passes, [18.0, 15.0], atol=0.5)
 
 
+@pytest.mark.parametrize("other", [{"reduced_gravity": {"law": "reece1965"}},
+                                   {"reduced_gravity": {"law": "wong_kobayashi2012"}},
+                                   {"slip_sinkage": {"law": "lyasko2010"}}])
+def test_the_rerun_soil_is_what_gravity_and_slip_then_act_on(other):
+    # a rerun rut reloads at K_e (Krenn & Hirzinger 2009); reduced gravity and Lyasko's slip
+    # softening then scale that soil as they scale a virgin one (terramechanics.SOIL_ORDER):
+    # the rerun equals a virgin soil kc = 0, kphi = K_e, n = 1 under the same other effect
+    k_e = 4e7
+    slips = np.array([0.1, 0.4])
+    rerun = BB2.with_effects(multipass={"law": "krenn_hirzinger2009",
+                                        "elastic_stiffness_pa_m": k_e}, **other)
+    linear = BB2.with_soil(kc=0.0, kphi=k_e, n=1.0).with_effects(**other)
+    for q in ("sinkage_m", "dp_n", "torque_nm"):
+        np.testing.assert_allclose(
+            rerun.curves(180.0, slips, multipass=1, gravity_mps2=3.71)[q],
+            linear.curves(180.0, slips, gravity_mps2=3.71)[q], rtol=1e-9)
+
+
 SLIPS = np.linspace(0.05, 0.7, 14)
 
 

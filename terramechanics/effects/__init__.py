@@ -43,6 +43,14 @@ DEFAULT_LAWS: dict[str, str] = {
 
 EFFECTS: dict[str, type[Effect]] = {name: LAWS[name][DEFAULT_LAWS[name]] for name in LAWS}
 
+#: the order in which the effects' ``soil`` hooks act: multipass first, because its law
+#: gives the soil that the earlier passes left (Krenn & Hirzinger's elastic reload
+#: *replaces* the pressure-sinkage law), and the other effects then act on that soil: the
+#: gravity scaling of its strength terms, the slip softening, the lugs. In the vocabulary
+#: order a re-run rut under reduced gravity lost the gravity scaling of its stiffness, and
+#: a slipping re-run wheel its Lyasko softening. The laws that only multiply commute.
+SOIL_ORDER: tuple[str, ...] = ("multipass",) + tuple(n for n in LAWS if n != "multipass")
+
 
 def law_class(name: str, law: str | None = None) -> type[Effect]:
     """The class of ``law`` of effect ``name`` (its default law when ``law`` is None)."""
@@ -59,5 +67,5 @@ def make_effect(name: str, law: str | None = None, **params: float) -> Effect:
     return law_class(name, law)(**params)
 
 
-__all__ = ["DEFAULT_LAWS", "EFFECTS", "Effect", "FitParam", "LAWS", "law_class",
-           "make_effect"] + [cls.__name__ for cls in _ALL]
+__all__ = ["DEFAULT_LAWS", "EFFECTS", "Effect", "FitParam", "LAWS", "SOIL_ORDER",
+           "law_class", "make_effect"] + [cls.__name__ for cls in _ALL]

@@ -9,9 +9,11 @@ pressed down plastically to some pressure responds to a later load elastically,
 modulus, until that pressure is exceeded; then it yields along the virgin Bekker
 curve. A wheel running again with the same load in its own rut (multipass index
 ``i >= 1``) meets such soil: here its pressure-sinkage becomes ``K_e dz`` (kc -> 0,
-kphi -> K_e, n0 -> 1; slip-sinkage still adds its slope), the same for every later
-pass. Neglects the yield beyond the earlier pressure, so it holds while the reloading
-pressure stays near the first pass's (``K_e`` not far above the soil's secant
+kphi -> K_e, n0 -> 1), the same for every later pass; the other effects then act on
+that soil (``terramechanics.SOIL_ORDER``: reduced gravity scales K_e, slip-sinkage adds
+its slope or softening). Neglects the yield beyond the earlier pressure, so it holds
+while the reloading pressure stays near the first pass's (``K_e`` not far above the soil's
+secant
 stiffness at the first-pass sinkage; below that secant it would be softer than virgin
 soil, which SCM forbids: K_e > kphi). The default K_e = 2.7e7 Pa/m (1.5 x the example's
 kphi) reproduces the ExoMars BB2 resistance at multipass 2 (about 15 N at 180 N, swtlab
