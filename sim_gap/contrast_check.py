@@ -62,9 +62,10 @@ def twin_differences(points: pd.DataFrame, residuals: np.ndarray, column: str
 
 def contrast_problem(points: pd.DataFrame, residuals: np.ndarray, effects: list[str]
                      ) -> str | None:
-    """Why a call of ``effects`` cannot be confident: the standardised ``residuals`` (points
-    x quantities, of the chosen candidate's fit) of a factor level differ from their twins'
-    at the first level while the call has no effect tied to that factor; None if not."""
+    """Why a call cannot be confident: the standardised ``residuals`` (points x quantities,
+    of the chosen candidate's fit) of a factor level differ from their twins' at the first
+    level while ``effects`` (the call's and those the simulation already has) hold no
+    effect tied to that factor; None if not."""
     names = quantities_of(points)
     for column, (words, effect) in TIED_FACTORS.items():
         if effect in effects or column not in points:

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+import terramechanics as tm
+
 from sim_gap import candidates as cands
 from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
 from sim_gap.aliasing import SEPARATING_RUN, aliasing_problem
@@ -122,9 +124,10 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     decision = unless(decision, aliasing_problem(
         points, sim.model.wheel, list(chosen.candidate.effects),
         dict(zip(chosen.candidate.effects, chosen.candidate.laws)), chosen.values), "aliased")
+    modelled = [e for e in tm.EFFECTS if e not in sim.missing_effects()]
     decision = unless(decision, contrast_problem(
         points, standardised_residuals(points, sim.predict(points, chosen.values), sig),
-        list(chosen.candidate.effects)), "level_contrast")
+        list(chosen.candidate.effects) + modelled), "level_contrast")
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
                                "out: " + ", ".join(sorted(untestable)))
