@@ -32,9 +32,10 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   (``swt.zero`` alone says nothing about the drift since the zeroing). ``fz``'s zero is
   ``swt.zero``'s, taken with the wheel lifted before the run: its drift from that zeroing to
   the first rest is a random walk with the same diffusion over the zero's age, variance
-  ``sigma^2 (zero_age_s + t_rest)`` (``zero_age_s``: the lab's stated time from the zeroing
-  to a run's start, the longest where it varies, so the term is an upper bound for a pure
-  walk; not stated: listed as not measured). The other cells are re-zeroed at the rests.
+  ``sigma^2 (zero_age_s / 2 + t_rest)`` (``zero_age_s``: the lab's stated longest time from
+  the zeroing to a run's start; the age itself is taken as rectangular between 0 and that
+  bound, GUM 4.3.7, whose mean is half of it, :func:`zero_at_window`; not stated: listed as
+  not measured). The other cells are re-zeroed at the rests.
 - ``calibration``: ``gain_rel_u`` times what the gain scales (the mean) and, where the
   zero is not re-measured (``fz``, or no rests), ``offset_u`` (the spec's optional
   ``swt.calibration`` keys; not stated: not measured).
@@ -256,8 +257,14 @@ def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[floa
                    rest_value: float | None, zero_age_s: float = 0.0) -> ZeroAtWindow:
     """The zero of ``column`` over the window: the rests' means less ``rest_value`` (what the
     cell carries at rest; None: not known, only the change since the first rest is drift,
-    and the zero, ``zero_age_s`` old at the run's start, drifted unseen until the first
-    rest), linear in time between the rests, with its uncertainty (module doc)."""
+    and the zero, at most ``zero_age_s`` old at the run's start, drifted unseen until the
+    first rest), linear in time between the rests, with its uncertainty (module doc).
+
+    The unseen age: only its bound is known, so it is taken as rectangular on
+    ``[0, zero_age_s]`` (GUM 4.3.7). A walk of diffusion ``sigma^2`` over an age ``A`` has
+    mean 0 and variance ``sigma^2 A`` given ``A``, so over the unknown age (law of total
+    variance) ``sigma^2 E[A] = sigma^2 zero_age_s / 2``: the ``age_s`` of the part is
+    ``zero_age_s / 2 + t_rest``."""
     if rests is None or column not in rests.before or column not in rests.after:
         return ZeroAtWindow(0.0, None, "zero drift (no rest readings before and after the drive)")
     b, a = rests.before[column], rests.after[column]
@@ -269,7 +276,7 @@ def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[floa
     means = _rss([Term((1 - w) * b.stats.se, max(b.stats.n_eff - 1, 1)),
                   Term(w * a.stats.se, max(a.stats.n_eff - 1, 1))])
     beta = bridge_factor((window_s[0] - b.t_s) / span, (window_s[1] - b.t_s) / span)
-    age = 0.0 if rest_value is not None else zero_age_s + max(b.t_s, 0.0)
+    age = 0.0 if rest_value is not None else zero_age_s / 2.0 + max(b.t_s, 0.0)
     return ZeroAtWindow(zero, DriftPart(column, 1.0, means, span, beta, d1 - d0, age))
 
 

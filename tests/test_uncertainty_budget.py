@@ -182,10 +182,11 @@ def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
 
 
 def test_the_fz_zero_drifts_unseen_from_the_zeroing_to_the_first_rest():
-    """fz is zeroed (swt.zero) ``zero_age_s`` before the run and re-zeroed never: a random
-    walk of diffusion 0.002 N^2/s over those 120 s and the 1.35 s to the first rest's mean
-    time: 120 s of it add 0.002 * 120 = 0.24 N^2 to its zero's variance; the DP cell,
-    re-zeroed at the rests, has no unseen age."""
+    """fz is zeroed (swt.zero) at most ``zero_age_s`` = 120 s before the run and re-zeroed
+    never: a random walk of diffusion 0.002 N^2/s over an age rectangular on [0, 120] s and
+    the 1.35 s to the first rest's mean time. Its variance, checked against 20,000 simulated
+    walks with ages drawn on [0, 120] s, is 0.002 * 60 = 0.12 N^2 above a fresh zero's; the
+    DP cell, re-zeroed at the rests, has no unseen age."""
     rng = np.random.default_rng(8)
     t = np.arange(0.0, 50.0, 0.01)
     moving = (t > 3.0) & (t < 47.0)
@@ -197,8 +198,12 @@ def test_the_fz_zero_drifts_unseen_from_the_zeroing_to_the_first_rest():
     fresh, aged = (zero_at_window(rests, "fz_n", (20.0, 40.0), None, age).part
                    for age in (0.0, 120.0))
     assert (fresh.age_s, aged.age_s) == (pytest.approx(1.35, abs=0.05),
-                                         pytest.approx(121.35, abs=0.05))
-    assert aged.term(diffusion).u ** 2 - fresh.term(diffusion).u ** 2 == pytest.approx(0.24)
+                                         pytest.approx(61.35, abs=0.05))
+    ages = np.random.default_rng(9).uniform(0.0, 120.0, 20_000)
+    walks = np.random.default_rng(10).normal(0.0, np.sqrt(0.002 * ages))
+    added = aged.term(diffusion).u ** 2 - fresh.term(diffusion).u ** 2
+    assert added == pytest.approx(np.var(walks), rel=0.03)
+    assert added == pytest.approx(0.12)
     dp_part = zero_at_window(rests, "dp_n", (20.0, 40.0), 0.0, 120.0).part
     assert dp_part.age_s == 0.0
 
