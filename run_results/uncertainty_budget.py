@@ -32,9 +32,11 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   (``swt.zero`` alone says nothing about the drift since the zeroing). ``fz``'s zero is
   ``swt.zero``'s, taken with the wheel lifted before the run: its drift from that zeroing to
   the first rest is a random walk with the same diffusion over the zero's age, variance
-  ``sigma^2 (zero_age_s + t_rest)`` (``zero_age_s``: the lab's stated time from the zeroing
-  to a run's start, the longest where it varies, so the term is an upper bound for a pure
-  walk; not stated: listed as not measured). The other cells are re-zeroed at the rests.
+  ``sigma^2 (E[age] + t_rest)`` (``zero_age_s``: the lab's stated longest time from the
+  zeroing to a run's start, ``zero_age_min_s`` the shortest, 0 if not stated; the age is
+  taken as rectangular between them, GUM 4.3.7, :attr:`BudgetParams.zero_age_mean_s`;
+  ``zero_age_s`` not stated: listed as not measured). The other cells are re-zeroed at the
+  rests.
 - ``calibration``: ``gain_rel_u`` times what the gain scales (the mean) and, where the
   zero is not re-measured (``fz``, or no rests), ``offset_u`` (the spec's optional
   ``swt.calibration`` keys; not stated: not measured).
@@ -89,16 +91,33 @@ INF = math.inf
 class BudgetParams:
     """What the budget is told about the rig: the loggers' clock tolerance (ppm, bound; None:
     not stated, :data:`DEFAULT_CLOCK_PPM` is used and the budget says so) and the age of the
-    load cells' zero at a run's start (s, the longest; None: not stated, module doc)."""
+    load cells' zero at a run's start (s: ``zero_age_s`` the longest, None: not stated,
+    module doc; ``zero_age_min_s`` the shortest, None: 0)."""
 
     clock_rate_bound_ppm: float | None = None
     zero_age_s: float | None = None
+    zero_age_min_s: float | None = None
 
     def __post_init__(self) -> None:
-        for name in ("clock_rate_bound_ppm", "zero_age_s"):
+        for name in ("clock_rate_bound_ppm", "zero_age_s", "zero_age_min_s"):
             value = getattr(self, name)
             if value is not None and not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} {value} must be >= 0")
+        if self.zero_age_min_s is not None and not (self.zero_age_s is not None
+                                                    and self.zero_age_min_s <= self.zero_age_s):
+            raise ValueError(f"zero_age_min_s {self.zero_age_min_s} needs zero_age_s >= it "
+                             f"(zero_age_s {self.zero_age_s})")
+
+    @property
+    def zero_age_mean_s(self) -> float:
+        """The expected age of the zero at a run's start: only its bounds are stated, so the
+        age is taken as rectangular between them (GUM 4.3.7), whose mean is their midpoint.
+        A walk of diffusion ``sigma^2`` over an age ``A`` has mean 0 and variance
+        ``sigma^2 A`` given ``A``; over the unknown age (law of total variance) its variance
+        is ``sigma^2 E[A]``, so this mean, not the longest age, is the walk's time."""
+        if self.zero_age_s is None:
+            return 0.0
+        return (self.zero_age_s + (self.zero_age_min_s or 0.0)) / 2.0
 
     @property
     def clock_ppm(self) -> float:
@@ -111,7 +130,8 @@ class BudgetParams:
             "ppm assumed)",)
 
     def to_dict(self) -> dict:
-        return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm, "zero_age_s": self.zero_age_s}
+        return {"clock_rate_bound_ppm": self.clock_rate_bound_ppm, "zero_age_s": self.zero_age_s,
+                "zero_age_min_s": self.zero_age_min_s}
 
 
 @dataclass(frozen=True)
@@ -253,11 +273,12 @@ class ZeroAtWindow:
 
 
 def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[float, float],
-                   rest_value: float | None, zero_age_s: float = 0.0) -> ZeroAtWindow:
+                   rest_value: float | None, zero_age_mean_s: float = 0.0) -> ZeroAtWindow:
     """The zero of ``column`` over the window: the rests' means less ``rest_value`` (what the
     cell carries at rest; None: not known, only the change since the first rest is drift,
-    and the zero, ``zero_age_s`` old at the run's start, drifted unseen until the first
-    rest), linear in time between the rests, with its uncertainty (module doc)."""
+    and the zero, on average ``zero_age_mean_s`` old at the run's start
+    (:attr:`BudgetParams.zero_age_mean_s`), drifted unseen until the first rest), linear in
+    time between the rests, with its uncertainty (module doc)."""
     if rests is None or column not in rests.before or column not in rests.after:
         return ZeroAtWindow(0.0, None, "zero drift (no rest readings before and after the drive)")
     b, a = rests.before[column], rests.after[column]
@@ -269,7 +290,7 @@ def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[floa
     means = _rss([Term((1 - w) * b.stats.se, max(b.stats.n_eff - 1, 1)),
                   Term(w * a.stats.se, max(a.stats.n_eff - 1, 1))])
     beta = bridge_factor((window_s[0] - b.t_s) / span, (window_s[1] - b.t_s) / span)
-    age = 0.0 if rest_value is not None else zero_age_s + max(b.t_s, 0.0)
+    age = 0.0 if rest_value is not None else zero_age_mean_s + max(b.t_s, 0.0)
     return ZeroAtWindow(zero, DriftPart(column, 1.0, means, span, beta, d1 - d0, age))
 
 
@@ -326,7 +347,7 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
     scale = run.metadata.wheel.radius_m if per_radius else 1.0
     absolute = column != "fz_n"  # fz at rest reads the actual load, which it measures
     z = zero_at_window(rests, column, window_s, 0.0 if absolute else None,
-                       params.zero_age_s or 0.0)
+                       params.zero_age_mean_s)
     missing = [] if z.missing is None else [z.missing]
     if z.part is not None and not absolute and params.zero_age_s is None:
         missing.append("fz zero drift since the zeroing (zero_age_s not stated in "

@@ -13,8 +13,8 @@ from scipy import integrate, stats
 
 from run_results.rest_readings import rest_readings, resolution
 from run_results.stats import batch_means_se
-from run_results.uncertainty_budget import (QuantityBudget, Term, bridge_factor, combine,
-                                            pooled_diffusion, rect_normal_quantile,
+from run_results.uncertainty_budget import (BudgetParams, QuantityBudget, Term, bridge_factor,
+                                            combine, pooled_diffusion, rect_normal_quantile,
                                             zero_at_window)
 from run_results.uncertainty_budget import _quantisation as quantisation
 
@@ -150,7 +150,7 @@ def test_pooled_diffusion_of_random_walk_drifts():
 
 
 def test_an_unstated_clock_is_said_to_be_assumed():
-    from run_results.uncertainty_budget import DEFAULT_CLOCK_PPM, BudgetParams
+    from run_results.uncertainty_budget import DEFAULT_CLOCK_PPM
 
     assert BudgetParams().clock_ppm == DEFAULT_CLOCK_PPM and BudgetParams().clock_missing
     assert BudgetParams(150.0).clock_ppm == 150.0 and BudgetParams(150.0).clock_missing == ()
@@ -182,10 +182,11 @@ def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
 
 
 def test_the_fz_zero_drifts_unseen_from_the_zeroing_to_the_first_rest():
-    """fz is zeroed (swt.zero) ``zero_age_s`` before the run and re-zeroed never: a random
-    walk of diffusion 0.002 N^2/s over those 120 s and the 1.35 s to the first rest's mean
-    time: 120 s of it add 0.002 * 120 = 0.24 N^2 to its zero's variance; the DP cell,
-    re-zeroed at the rests, has no unseen age."""
+    """fz is zeroed (swt.zero) at most ``zero_age_s`` = 120 s before the run and re-zeroed
+    never: a random walk of diffusion 0.002 N^2/s over an age rectangular on [0, 120] s and
+    the 1.35 s to the first rest's mean time. Its variance, checked against 20,000 simulated
+    walks with ages drawn on [0, 120] s, is 0.002 * 60 = 0.12 N^2 above a fresh zero's; the
+    DP cell, re-zeroed at the rests, has no unseen age."""
     rng = np.random.default_rng(8)
     t = np.arange(0.0, 50.0, 0.01)
     moving = (t > 3.0) & (t < 47.0)
@@ -194,21 +195,40 @@ def test_the_fz_zero_drifts_unseen_from_the_zeroing_to_the_first_rest():
     fz = 180.0 + rng.normal(0, 0.05, t.size)
     rests = rest_readings(_run(t, angle, dp, fz, 180.0))
     diffusion = {"fz_n": Term(0.002, 50.0), "dp_n": Term(0.002, 50.0)}
+    mean_age_s = BudgetParams(zero_age_s=120.0).zero_age_mean_s
     fresh, aged = (zero_at_window(rests, "fz_n", (20.0, 40.0), None, age).part
-                   for age in (0.0, 120.0))
+                   for age in (0.0, mean_age_s))
     assert (fresh.age_s, aged.age_s) == (pytest.approx(1.35, abs=0.05),
-                                         pytest.approx(121.35, abs=0.05))
-    assert aged.term(diffusion).u ** 2 - fresh.term(diffusion).u ** 2 == pytest.approx(0.24)
-    dp_part = zero_at_window(rests, "dp_n", (20.0, 40.0), 0.0, 120.0).part
+                                         pytest.approx(61.35, abs=0.05))
+    ages = np.random.default_rng(9).uniform(0.0, 120.0, 20_000)
+    walks = np.random.default_rng(10).normal(0.0, np.sqrt(0.002 * ages))
+    added = aged.term(diffusion).u ** 2 - fresh.term(diffusion).u ** 2
+    assert added == pytest.approx(np.var(walks), rel=0.03)
+    assert added == pytest.approx(0.12)
+    dp_part = zero_at_window(rests, "dp_n", (20.0, 40.0), 0.0, mean_age_s).part
     assert dp_part.age_s == 0.0
 
 
+def test_a_stated_shortest_zero_age_moves_the_mean_age_to_the_bounds_midpoint():
+    """Bounds 30-180 s, rectangular (GUM 4.3.7): mean age 105 s, which 20,000 ages drawn
+    uniformly between the bounds average to."""
+    ages = np.random.default_rng(11).uniform(30.0, 180.0, 20_000)
+    params = BudgetParams(zero_age_s=180.0, zero_age_min_s=30.0)
+    assert params.zero_age_mean_s == pytest.approx(ages.mean(), rel=0.01)
+    assert params.zero_age_mean_s == 105.0
+    assert BudgetParams().zero_age_mean_s == 0.0
+    with pytest.raises(ValueError, match="zero_age_min_s 200.0 needs zero_age_s"):
+        BudgetParams(zero_age_s=180.0, zero_age_min_s=200.0)
+
+
 def test_the_zero_age_is_read_from_the_campaign_settings(tmp_path):
-    from run_results.uncertainty_budget import BudgetParams
     from swtlab.pipeline.process import budget_params
 
     (tmp_path / "swtlab.toml").write_text("[uncertainty]\nzero_age_s = 180\n")
     assert budget_params(tmp_path) == BudgetParams(None, 180.0)
+    (tmp_path / "swtlab.toml").write_text("[uncertainty]\nzero_age_s = 180\n"
+                                          "zero_age_min_s = 30\n")
+    assert budget_params(tmp_path) == BudgetParams(None, 180.0, 30.0)
     with pytest.raises(ValueError, match="zero_age_s -5"):
         BudgetParams(zero_age_s=-5.0)
 

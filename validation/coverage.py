@@ -11,9 +11,9 @@ then each run's ``mean +- u95`` is checked against its truth:
   ``bb2_sand`` model, ``ModelTruth``).
 
 The campaign's ``swtlab.toml`` states the loggers' clock tolerance the way a lab states its
-logger's datasheet value, and the longest time from zeroing the load cells to a run's start
-the way a lab states its procedure: the generator's own bounds (200 ppm and 0 s virtual: its
-drift starts at the run's start; 150 ppm and 180 s second rig).
+logger's datasheet value, and the shortest and longest time from zeroing the load cells to a
+run's start the way a lab states its procedure: the generator's own bounds (200 ppm and 0 s
+virtual: its drift starts at the run's start; 150 ppm and 30-180 s second rig).
 """
 
 from __future__ import annotations
@@ -50,9 +50,10 @@ def _draws(n: int, seed: int, loads: tuple[float, float]):
         yield i, kind, load, mp, slip
 
 
-def _settings(folder: Path, clock_ppm: float, zero_age_s: float) -> None:
+def _settings(folder: Path, clock_ppm: float, zero_age_s: tuple[float, float]) -> None:
     (folder / "swtlab.toml").write_text(f"[uncertainty]\nclock_rate_bound_ppm = {clock_ppm}\n"
-                                        f"zero_age_s = {zero_age_s}\n")
+                                        f"zero_age_min_s = {zero_age_s[0]}\n"
+                                        f"zero_age_s = {zero_age_s[1]}\n")
 
 
 def write_virtual(out: Path, n: int, seed: int, duration_s: float = 60.0) -> dict[str, dict]:
@@ -63,7 +64,7 @@ def write_virtual(out: Path, n: int, seed: int, duration_s: float = 60.0) -> dic
                                   slip if kind == "speed_control" else None))
     generate_campaign(out, conds, seed=seed, rates=SAMPLE_RATES, form="csv",
                       duration_s=duration_s)
-    _settings(out / "campaign", VirtualSensors().clock_rate_error_ppm, 0.0)
+    _settings(out / "campaign", VirtualSensors().clock_rate_error_ppm, (0.0, 0.0))
     truths = {}
     for c in conds:
         t = json.loads((out / "truth" / f"{c.run_id}.json").read_text())
@@ -91,7 +92,7 @@ def write_second(out: Path, n: int, seed: int) -> dict[str, dict]:
              for i, kind, load, mp, slip in _draws(n, seed, (80.0, 300.0))]
     sensors = SensorModel(write_calibration_uncertainty=True)
     write_campaign(out, conds, ModelTruth(model), seed, form="csv", rig=Rig(sensors=sensors))
-    _settings(out / "campaign", sensors.clock_ppm_max, max(sensors.zero_lead_s))
+    _settings(out / "campaign", sensors.clock_ppm_max, sensors.zero_lead_s)
     return {c.run_id: json.loads((out / "truth" / f"{c.run_id}.json").read_text())["steady"]
             for c in conds}
 

@@ -72,13 +72,14 @@ def rig_compliance(folder: Path, path: Path | None = None):
 
 def budget_params(folder: Path):
     """The ``[uncertainty]`` of ``folder/swtlab.toml`` (``clock_rate_bound_ppm``: the loggers'
-    stated clock tolerance; ``zero_age_s``: the longest time from zeroing the load cells to a
-    run's start) as ``BudgetParams``; nothing stated without the file or table."""
+    stated clock tolerance; ``zero_age_s``, ``zero_age_min_s``: the longest and shortest time
+    from zeroing the load cells to a run's start) as ``BudgetParams``; nothing stated without
+    the file or table."""
     from run_results.uncertainty_budget import BudgetParams
 
     source = Path(folder) / CAMPAIGN_SETTINGS
     table = tomllib.loads(source.read_text()).get("uncertainty", {}) if source.is_file() else {}
-    unknown = sorted(set(table) - {"clock_rate_bound_ppm", "zero_age_s"})
+    unknown = sorted(set(table) - {"clock_rate_bound_ppm", "zero_age_s", "zero_age_min_s"})
     if unknown:
         raise ValueError(f"{source}: [uncertainty] has unknown key(s) {unknown}")
     return BudgetParams(**{k: float(v) for k, v in table.items()})
