@@ -62,14 +62,16 @@ def candidate_text(label: str) -> str:
 
 def words(text: str, labels: list[str]) -> str:
     """``text`` (written with the JSON's candidate labels, effect names and law keys) in plain
-    words: each label by its plain name, each law by its authors and year, standard errors
-    and sigmas spelt out."""
+    words: each label by its plain name, each law by its authors and year, each quantity by
+    its name, standard errors and sigmas spelt out."""
     sets = {re.sub(r"\([^)]*\)", "", n) for n in labels}  # the effect sets, laws dropped
     names = sorted({n for n in {*labels, *sets, *EFFECTS, SOIL_ONLY}
                     if "_" in n or "+" in n or "(" in n}, key=len, reverse=True)
     pattern = re.compile(r"(?<![\w+])(" + "|".join(map(re.escape, names)) + r")(?![\w+])")
     text = pattern.sub(lambda m: candidate_text(m.group(1)), text)
     text = re.sub(r"\b[a-z_]+\d{4}\b", lambda m: law_text(m.group(0)), text)  # a law's key
+    text = re.sub(r"\b(" + "|".join(q for q in QUANTITIES if "_" in q) + r")\b",
+                  lambda m: QUANTITIES[m.group(1)].label, text)  # a quantity's column
     text = re.sub(r"(\d) SE\b", r"\1 standard errors", text)
     return re.sub(r"\bsigma\b", "σ", text).replace("m/s^2", "m/s²").strip()
 

@@ -204,6 +204,15 @@ def test_plain_words_and_display_units():
         "Under the best-fitting laws the verdict is slip sinkage (slip sinkage (Ding 2011)), "
         "but with slip sinkage under Lyasko 2010 it is grousers + slip sinkage (grousers "
         "(Ding 2011) + slip sinkage (Lyasko 2010)) on ding2011_lug10.")
+    # a level-contrast reason (sim_gap.contrast_check) names a quantity and an effect
+    assert plain("the residuals of sinkage_m at multipass level 1 differ from their twin runs' "
+                 "at multipass level 0 by -4.44 sigma (11.0 SE over 24 pairs), which no effect "
+                 "of the call explains: an effect tied to the multipass level (multipass, or "
+                 "another) may be missing", ["reduced_gravity(reece1965)"]) == (
+        "The residuals of sinkage at multipass level 1 differ from their twin runs' at "
+        "multipass level 0 by -4.44 σ (11.0 standard errors over 24 pairs), which no effect "
+        "of the call explains: an effect tied to the multipass level (multipass, or another) "
+        "may be missing.")
     for effect, laws in tm.LAWS.items():
         for law in laws:
             assert "_" not in candidate_text(f"{effect}({law})")
