@@ -4,16 +4,16 @@ Each effect is a family of published laws (``terramechanics.effects.LAWS``); rea
 follows none of them exactly. A verdict is confident only if the decision rule
 (``sim_gap.decide``) gives the same confident verdict under every law assignment that
 could have made the data: the reference assignment and each effect switched to each of
-its other laws, one at a time (a
-one-at-a-time sensitivity design, Saltelli et al. 2008, Global Sensitivity Analysis: The
-Primer, ch. 2). The reference is the assignment of the best candidate of all
-(:func:`best_fitting_laws`: its effects' laws, the others each at the law that scored best
-alone); until 0.7.0 it was each effect's best law alone, and a pair whose effects fit best
-under other laws than alone was judged under laws the data reject. An assignment whose best candidate loses to the reference's best by the
-margin of a confident call (``Z_CONFIDENT`` paired SE and ``MIN_GAIN`` of its held-out
-loss) is *refuted by the data*: it is listed, and does not vote. Any disagreement among
-the others makes the verdict ``inconclusive``, naming the laws that disagree. Nothing here
-(nor in ``decide``) reads the shrink: a large shrink never raises confidence.
+its other laws, one at a time (a one-at-a-time sensitivity design, Saltelli et al. 2008,
+Global Sensitivity Analysis: The Primer, ch. 2). The reference is the assignment of the
+best candidate of all (:func:`best_fitting_laws`: its effects' laws, the others each at
+the law that scored best alone); until 0.7.0 it was each effect's best law alone, and a
+pair whose effects fit best under other laws than alone was judged under laws the data
+reject. An assignment whose best candidate loses to the reference's best by the margin of
+a confident call (``Z_CONFIDENT`` paired SE and ``MIN_GAIN`` of its held-out loss) is
+*refuted by the data*: it is listed, and does not vote. Any disagreement among the others
+makes the verdict ``inconclusive``, naming the laws that disagree. Nothing here (nor in
+``decide``) reads the shrink: a large shrink never raises confidence.
 """
 
 from __future__ import annotations
