@@ -20,7 +20,7 @@ from sim_gap.decide import rank, unless
 from sim_gap.discriminate import separating_test
 from sim_gap.fit import quantities_of, sigmas, standardised_residuals
 from sim_gap.identify import identification_problem
-from sim_gap.laws import reference_laws, robust_decide
+from sim_gap.laws import best_fitting_laws, reference_laws, robust_decide
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
 from sim_gap.simulated import Simulated
@@ -117,7 +117,7 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     pairs = cands.pairs(sim.model, allowed, reference)
     results.update(_run_all(sim, pairs, points, sig, settings,
                             [_pair_start(c, results) for c in pairs]))
-    decision = robust_decide(results, allowed, reference, n)
+    decision = robust_decide(results, allowed, best_fitting_laws(results, reference, n), n)
     chosen = results[decision["chosen"]].full
     decision = unless(decision, identification_problem(sim, chosen, points, sig),
                       "unidentifiable")

@@ -12,7 +12,7 @@ from sim_gap import candidates
 from sim_gap.decide import decide, paired_z, rank
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.discriminate import separating_test
-from sim_gap.laws import assignments, reference_laws, robust_decide
+from sim_gap.laws import assignments, best_fitting_laws, reference_laws, robust_decide
 from sim_gap.simulated import Simulated
 
 BASE = tm.shipped_model("bb2_sand").with_effects(**{n: False for n in tm.EFFECTS})
@@ -276,6 +276,35 @@ def test_a_call_that_holds_under_one_law_only_is_inconclusive_naming_the_law():
     sens = out["law_sensitivity"]
     assert sens["robust"] and not sens["refuted"] and [
         a["verdict"] for a in sens["assignments"]] == [["slip_sinkage"], ["slip_sinkage"]]
+
+
+def test_the_law_check_is_centred_on_the_best_candidates_laws():
+    """Bench seed 22 c005 in family: Bekker's flexible wheel fits best alone, but with
+    slip-sinkage the pair fits best under Wong's law (the truth's). Centred on each effect's
+    best law alone, the call was read under Bekker's flexibility, where the pair hardly beats
+    slip-sinkage alone: inconclusive. Centred on the best candidate's laws it is the pair."""
+    rng = np.random.default_rng(6)
+    noise = lambda s=0.02: rng.normal(0, s, 40)  # noqa: E731
+    slip = 1.2 + noise(0.1)
+    losses = {"soil_only": 9 + noise(), "slip_sinkage(lyasko2010)": slip,
+              "wheel_flexibility(bekker1969)": 3.0 + noise(),
+              "wheel_flexibility(wong2010)": 3.3 + noise(),
+              "slip_sinkage(lyasko2010)+wheel_flexibility(bekker1969)": 0.97 * slip,
+              "slip_sinkage(lyasko2010)+wheel_flexibility(wong2010)": 0.01 + noise(0.002)}
+    allowed = {"slip_sinkage": ("lyasko2010",),
+               "wheel_flexibility": ("bekker1969", "wong2010")}
+    results = _fake(losses)
+    alone = reference_laws(results, 40)
+    assert alone == {"slip_sinkage": "lyasko2010", "wheel_flexibility": "bekker1969"}
+    centre = best_fitting_laws(results, alone, 40)
+    assert centre == {"slip_sinkage": "lyasko2010", "wheel_flexibility": "wong2010"}
+    assert robust_decide(results, allowed, alone, 40)["verdict"] == "inconclusive"
+    out = robust_decide(results, allowed, centre, 40)
+    assert out["verdict"] == ["slip_sinkage", "wheel_flexibility"]
+    assert out["chosen"] == "slip_sinkage(lyasko2010)+wheel_flexibility(wong2010)"
+    (refuted,) = out["law_sensitivity"]["refuted"]
+    assert refuted == {"effect": "wheel_flexibility", "law": "bekker1969",
+                       "z_best_vs_reference": refuted["z_best_vs_reference"]}
 
 
 def test_pairs_vary_one_law_at_a_time():
