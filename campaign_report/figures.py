@@ -10,7 +10,6 @@ import warnings
 import matplotlib
 import numpy as np
 import pandas as pd
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
@@ -18,7 +17,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from campaign_report.data import RunRecord, SetKey
-from campaign_report.images import FULL_DPI, Rendered, pixels
+from campaign_report.images import Rendered, canvas_of, pixels
 from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
                                    plain_text)
 from fitting import CurveFit, ValidationResult, band, curves_by_load, interpolate_load
@@ -165,11 +164,7 @@ class RunTimeseries:
         legend and layout and copied in, and only the axes (labels hidden) and the title are
         drawn per run. Same pixels: the fixed parts overlap nothing drawn per run."""
         figure = self.draw(run)
-        canvas = figure.canvas
-        if not isinstance(canvas, FigureCanvasAgg):
-            canvas = FigureCanvasAgg(figure)
-            figure.set_dpi(FULL_DPI)
-            figure.patch.set_facecolor("white")
+        canvas = canvas_of(figure)
         renderer = canvas.get_renderer()
         labels = [axis.label for ax in self.axes for axis in (ax.xaxis, ax.yaxis)]
         key = (*map(id, figure.legends), figure.subplotpars.top)

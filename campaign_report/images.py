@@ -120,13 +120,19 @@ def encode(rgba: np.ndarray, palette: np.ndarray | None,
     return out.getvalue()
 
 
-def render(fig: Figure, dpi: int = FULL_DPI) -> Rendered:
-    """``fig`` drawn once at ``dpi`` on white (its pixels copied: a reused figure is drawn
-    again), and its palette."""
+def canvas_of(fig: Figure, dpi: int = FULL_DPI) -> FigureCanvasAgg:
+    """``fig``'s in-memory (Agg) canvas, at ``dpi``, on white."""
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     if fig.dpi != dpi:
         fig.set_dpi(dpi)
     fig.patch.set_facecolor("white")
+    return canvas
+
+
+def render(fig: Figure, dpi: int = FULL_DPI) -> Rendered:
+    """``fig`` drawn once at ``dpi`` on white (its pixels copied: a reused figure is drawn
+    again), and its palette."""
+    canvas = canvas_of(fig, dpi)
     canvas.draw()
     return pixels(canvas)
 
