@@ -53,6 +53,12 @@ def _no_data(ax, text: str):
             bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85})
 
 
+def _show(artist, label: str | None) -> None:
+    """Show ``artist`` with its legend ``label``; None: hide it, out of the legend."""
+    artist.set_visible(label is not None)
+    artist.set_label("_hidden" if label is None else label)
+
+
 class RunTimeseries:
     """One figure of drawbar pull, torque, sinkage and slip against time, reused for every
     run of a page: its axes, ticks, labels and grid are made once and each :meth:`draw`
@@ -78,7 +84,12 @@ class RunTimeseries:
                 ax.tick_params(labelbottom=False)
         self.axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
         self.title = self.figure.suptitle("", fontsize="medium")
-        self._drawn: list = []  # the artists of the run drawn last
+        # each axis's window, mean and trace, shown or hidden and given each run's data
+        # (made once: creating them was a third of a run's artist time)
+        self._kept = [(ax.axvspan(0.0, 1.0, color=WINDOW_COLOUR, zorder=0),
+                       *ax.plot([], [], color="k", ls="--", lw=1.2),
+                       *ax.plot([], [], lw=0.8)) for ax in self.axes]
+        self._drawn: list = []  # the other artists of the run drawn last
         self._legends: dict = {}  # (labels, trace colour) -> legend
         self._backgrounds: dict = {}  # (legend, axes' top) -> pixels of the fixed parts
 
@@ -86,9 +97,18 @@ class RunTimeseries:
         for artist in self._drawn:
             artist.remove()
         self._drawn = []
+        for kept in self._kept:
+            for artist in kept:
+                _show(artist, None)
         for ax in self.axes:
-            ax.relim()  # no data left: limits from this run's artists only
             ax.set_autoscale_on(True)
+
+    def _limits(self) -> None:
+        """Each axis's data limits from this run's shown artists only, autoscaled where no
+        limit was set."""
+        for ax in self.axes:
+            ax.relim(visible_only=True)
+            ax.autoscale_view()
 
     def _time_range(self) -> None:
         """The time span of the run's artists on all four axes, with the default margins."""
@@ -121,21 +141,25 @@ class RunTimeseries:
         self.figure.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
         colour = self.palette.colour(run.load_n)
         drawn = self._drawn
-        for ax, key in zip(self.axes, TRACE_QUANTITIES):
+        for ax, key, (span, mean_line, trace_line) in zip(self.axes, TRACE_QUANTITIES,
+                                                           self._kept):
             q = QUANTITIES[key]
             y_data = False
             if run.window_start_s is not None and run.window_end_s is not None:
-                drawn.append(ax.axvspan(run.window_start_s, run.window_end_s,
-                                        color=WINDOW_COLOUR, zorder=0, label="stable window"))
+                span.set_x(run.window_start_s)
+                span.set_width(run.window_end_s - run.window_start_s)
+                _show(span, "stable window")
                 if key in run.means:
                     mean = run.means[key] * q.scale  # a Line2D: a third of hlines' cost
-                    drawn += ax.plot([run.window_start_s, run.window_end_s], [mean, mean],
-                                     color="k", ls="--", lw=1.2, label="mean over window")
+                    mean_line.set_data([run.window_start_s, run.window_end_s], [mean, mean])
+                    _show(mean_line, "mean over window")
                     y_data = True
             trace = None if run.traces is None else run.traces.get(key)
             if trace is not None:
                 values = np.asarray(trace.values, float) * q.scale
-                drawn += ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
+                trace_line.set_data(trace.t_s, values)
+                trace_line.set_color(colour)
+                _show(trace_line, "stored trace")
                 _robust_limits(ax, values)
                 continue
             drawn.append(_no_data(ax, NOT_STORED if run.traces is None else "not measured"))
@@ -146,6 +170,7 @@ class RunTimeseries:
                 y_data = True
             if not y_data:
                 ax.set_ylim(0.0, 1.0)
+        self._limits()
         self._time_range()
         self._legend(colour)
         title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass "
