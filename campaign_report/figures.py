@@ -85,7 +85,7 @@ class RunTimeseries:
         self.axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
         self.title = self.figure.suptitle("", fontsize="medium")
         # each axis's window, mean and trace, shown or hidden and given each run's data
-        # (made once: creating them was a third of a run's artist time)
+        # (made once: creating them was two thirds of a run's artist time)
         self._kept = [(ax.axvspan(0.0, 1.0, color=WINDOW_COLOUR, zorder=0),
                        *ax.plot([], [], color="k", ls="--", lw=1.2),
                        *ax.plot([], [], lw=0.8)) for ax in self.axes]
