@@ -17,6 +17,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from campaign_report.data import RunRecord, SetKey
+from campaign_report.images import Rendered, canvas_of, pixels
 from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
                                    plain_text)
 from fitting import CurveFit, ValidationResult, band, curves_by_load, interpolate_load
@@ -52,6 +53,12 @@ def _no_data(ax, text: str):
             bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85})
 
 
+def _show(artist, label: str | None) -> None:
+    """Show ``artist`` with its legend ``label``; None: hide it, out of the legend."""
+    artist.set_visible(label is not None)
+    artist.set_label("_hidden" if label is None else label)
+
+
 class RunTimeseries:
     """One figure of drawbar pull, torque, sinkage and slip against time, reused for every
     run of a page: its axes, ticks, labels and grid are made once and each :meth:`draw`
@@ -71,21 +78,37 @@ class RunTimeseries:
             ax.xaxis.set_major_locator(MaxNLocator(TIME_BINS))
             ax.yaxis.set_major_locator(MaxNLocator(VALUE_BINS))
             ax.grid(alpha=0.3)
+            # fixed also where empty: an axis placing its label measures its tick labels
+            ax.xaxis.set_label_coords(0.5, XLABEL_Y)
             if ax is not self.axes[-1]:
                 ax.tick_params(labelbottom=False)
         self.axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
-        self.axes[-1].xaxis.set_label_coords(0.5, XLABEL_Y)
         self.title = self.figure.suptitle("", fontsize="medium")
-        self._drawn: list = []  # the artists of the run drawn last
+        # each axis's window, mean and trace, shown or hidden and given each run's data
+        # (made once: creating them was two thirds of a run's artist time)
+        self._kept = [(ax.axvspan(0.0, 1.0, color=WINDOW_COLOUR, zorder=0),
+                       *ax.plot([], [], color="k", ls="--", lw=1.2),
+                       *ax.plot([], [], lw=0.8)) for ax in self.axes]
+        self._drawn: list = []  # the other artists of the run drawn last
         self._legends: dict = {}  # (labels, trace colour) -> legend
+        self._backgrounds: dict = {}  # (legend, axes' top) -> pixels of the fixed parts
 
     def _clear(self) -> None:
         for artist in self._drawn:
             artist.remove()
         self._drawn = []
+        for kept in self._kept:
+            for artist in kept:
+                _show(artist, None)
         for ax in self.axes:
-            ax.relim()  # no data left: limits from this run's artists only
             ax.set_autoscale_on(True)
+
+    def _limits(self) -> None:
+        """Each axis's data limits from this run's shown artists only, autoscaled where no
+        limit was set."""
+        for ax in self.axes:
+            ax.relim(visible_only=True)
+            ax.autoscale_view()
 
     def _time_range(self) -> None:
         """The time span of the run's artists on all four axes, with the default margins."""
@@ -118,21 +141,25 @@ class RunTimeseries:
         self.figure.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
         colour = self.palette.colour(run.load_n)
         drawn = self._drawn
-        for ax, key in zip(self.axes, TRACE_QUANTITIES):
+        for ax, key, (span, mean_line, trace_line) in zip(self.axes, TRACE_QUANTITIES,
+                                                           self._kept):
             q = QUANTITIES[key]
             y_data = False
             if run.window_start_s is not None and run.window_end_s is not None:
-                drawn.append(ax.axvspan(run.window_start_s, run.window_end_s,
-                                        color=WINDOW_COLOUR, zorder=0, label="stable window"))
+                span.set_x(run.window_start_s)
+                span.set_width(run.window_end_s - run.window_start_s)
+                _show(span, "stable window")
                 if key in run.means:
                     mean = run.means[key] * q.scale  # a Line2D: a third of hlines' cost
-                    drawn += ax.plot([run.window_start_s, run.window_end_s], [mean, mean],
-                                     color="k", ls="--", lw=1.2, label="mean over window")
+                    mean_line.set_data([run.window_start_s, run.window_end_s], [mean, mean])
+                    _show(mean_line, "mean over window")
                     y_data = True
             trace = None if run.traces is None else run.traces.get(key)
             if trace is not None:
                 values = np.asarray(trace.values, float) * q.scale
-                drawn += ax.plot(trace.t_s, values, color=colour, lw=0.8, label="stored trace")
+                trace_line.set_data(trace.t_s, values)
+                trace_line.set_color(colour)
+                _show(trace_line, "stored trace")
                 _robust_limits(ax, values)
                 continue
             drawn.append(_no_data(ax, NOT_STORED if run.traces is None else "not measured"))
@@ -143,6 +170,7 @@ class RunTimeseries:
                 y_data = True
             if not y_data:
                 ax.set_ylim(0.0, 1.0)
+        self._limits()
         self._time_range()
         self._legend(colour)
         title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass "
@@ -154,6 +182,35 @@ class RunTimeseries:
         self.title.set_text(title)
         self.title.set_color("#a00000" if run.status != "ok" else "k")
         return self.figure
+
+    def render(self, run: RunRecord) -> Rendered:
+        """``run``'s figure (:meth:`draw`) as :func:`images.render` draws it, in less time:
+        the parts that are the same for many runs (axis labels, legend) are drawn once per
+        legend and layout and copied in, and only the axes (labels hidden) and the title are
+        drawn per run. Same pixels: the fixed parts overlap nothing drawn per run."""
+        figure = self.draw(run)
+        canvas = canvas_of(figure)
+        renderer = canvas.get_renderer()
+        labels = [axis.label for ax in self.axes for axis in (ax.xaxis, ax.yaxis)]
+        key = (*map(id, figure.legends), figure.subplotpars.top)
+        if key not in self._backgrounds:
+            renderer.clear()
+            figure.patch.draw(renderer)
+            for fixed in labels + figure.legends:
+                fixed.draw(renderer)
+            self._backgrounds[key] = canvas.copy_from_bbox(figure.bbox)
+        canvas.restore_region(self._backgrounds[key])
+        for label in labels:
+            label.set_visible(False)
+        try:
+            for ax in self.axes:
+                ax.apply_aspect()
+                ax.draw(renderer)
+            self.title.draw(renderer)
+        finally:
+            for label in labels:
+                label.set_visible(True)
+        return pixels(canvas)
 
 
 def run_timeseries(run: RunRecord, palette: Palette) -> Figure:

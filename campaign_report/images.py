@@ -120,22 +120,38 @@ def encode(rgba: np.ndarray, palette: np.ndarray | None,
     return out.getvalue()
 
 
-def render(fig: Figure, dpi: int = FULL_DPI) -> Rendered:
-    """``fig`` drawn once at ``dpi`` on white (its pixels copied: a reused figure is drawn
-    again), and its palette."""
+def canvas_of(fig: Figure, dpi: int = FULL_DPI) -> FigureCanvasAgg:
+    """``fig``'s in-memory (Agg) canvas, at ``dpi``, on white."""
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     if fig.dpi != dpi:
         fig.set_dpi(dpi)
     fig.patch.set_facecolor("white")
+    return canvas
+
+
+def render(fig: Figure, dpi: int = FULL_DPI) -> Rendered:
+    """``fig`` drawn once at ``dpi`` on white (its pixels copied: a reused figure is drawn
+    again), and its palette."""
+    canvas = canvas_of(fig, dpi)
     canvas.draw()
+    return pixels(canvas)
+
+
+def pixels(canvas: FigureCanvasAgg) -> Rendered:
+    """What ``canvas`` holds now (copied: a reused figure is drawn again), and its palette."""
     rgba = np.array(canvas.buffer_rgba(), copy=True)
     return Rendered(rgba, *_palette(_keys(rgba)))
+
+
+def png(rendered: Rendered) -> bytes:
+    """A rendered figure as a palette PNG (:func:`encode` with its palette and colours)."""
+    return encode(rendered.rgba, rendered.palette, rendered.colours)
 
 
 def to_png(fig: Figure, dpi: int = FULL_DPI) -> tuple[bytes, Rendered]:
     """The figure as a palette PNG, and its pixels and palette (for :func:`thumbnail`)."""
     rendered = render(fig, dpi)
-    return encode(rendered.rgba, rendered.palette, rendered.colours), rendered
+    return png(rendered), rendered
 
 
 def thumbnail(rendered: Rendered, width: int = THUMB_WIDTH_PX) -> bytes:

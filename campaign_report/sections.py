@@ -9,7 +9,7 @@ from html import escape
 from campaign_report import figures
 from campaign_report.data import CampaignData, RunRecord
 from campaign_report.html import Heading, Image, Note, Section, Table
-from campaign_report.images import thumbnail, to_png
+from campaign_report.images import png, thumbnail, to_png
 from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from run_results.traces import MAX_TRACE_POINTS
 from wpm_export import WheelPerformanceModule
@@ -97,10 +97,10 @@ def _timeseries_figure(palette: Palette) -> figures.RunTimeseries:
 def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Image:
     """A run's time-series thumbnail/full-size pair; the caption says so when the run was
     processed before its traces were stored."""
-    png, image = to_png(_timeseries_figure(palette).draw(run))
+    image = _timeseries_figure(palette).render(run)
     caption = (f"{run.run_id} · {run.status}"
                + (f" · {figures.NOT_STORED}" if run.traces is None else ""))
-    return Image(run_anchor(index), caption, png, thumbnail(image), run.status)
+    return Image(run_anchor(index), caption, png(image), thumbnail(image), run.status)
 
 
 def timeseries_section(images: Iterable[Image]) -> Section:

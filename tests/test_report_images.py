@@ -89,6 +89,16 @@ def test_a_reused_time_series_figure_draws_a_run_as_a_fresh_one_does():
     assert reused.axes[0].get_xlim()[1] < 40.0  # the 60 s run's limits are gone
 
 
+def test_a_time_series_drawn_over_its_copied_fixed_parts_is_the_whole_figure_drawn():
+    palette = Palette([70.0, 180.0], [0])
+    first, second = _run("a", 70.0, 60.0, 20.0), _run("b", 180.0, 30.0, 3.0)
+    reused = figures.RunTimeseries(palette)
+    for run in (first, second, first):  # the second load's legend, then the first's again
+        fresh = images.render(figures.run_timeseries(run, palette)).rgba
+        assert (reused.render(run).rgba == fresh).all()
+    assert len(reused._backgrounds) == 2
+
+
 def test_error_bars_hidden_by_their_markers_are_named_with_their_size():
     fig = Figure(figsize=(6.0, 4.0), dpi=100)
     ax = fig.add_axes((0.1, 0.1, 0.8, 0.8))   # 320 px high
