@@ -102,7 +102,6 @@ def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, flo
     return float(np.sqrt(max(var, 0.0))), dof
 
 
-
 def _obm_var(y: np.ndarray, batch: int) -> float:
     """Overlapping-batch-means estimate of ``var(mean)`` with batches of ``batch`` samples
     (Meketon & Schmeiser 1984): ``m sum_j (ybar_j - ybar)^2 / ((n - m + 1)(n - m))``."""
