@@ -91,18 +91,20 @@ def test_reprocessing_changes_nothing(tmp_path, db_url):
 
 
 def test_killed_batch_finishes_on_rerun_without_duplicates(tmp_path):
-    """SIGKILL mid-batch, run again: every run once, nothing lost (each run is one transaction)."""
+    """SIGKILL mid-batch, run again: every run once, nothing lost (each run is one transaction).
+    One worker, so runs are stored one by one as they are done (with a worker per core a
+    many-core machine stores all 16 within one poll)."""
     run_ids = sorted(p.stem for p in (SAMPLE / "campaign").glob("L300_*.mcap"))
     campaign = _small_campaign(tmp_path, run_ids)
     db_url = f"sqlite:///{tmp_path / 'swtlab.sqlite'}"
     command = [sys.executable, "-m", "swtlab_cli.main", "process", str(campaign), "--db", db_url,
-               "--quiet"]
+               "--jobs", "1", "--quiet"]
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                env={**os.environ, "PYTHONUNBUFFERED": "1"})
     deadline = time.monotonic() + 120
     stored = 0
     while time.monotonic() < deadline and process.poll() is None:
-        time.sleep(0.2)
+        time.sleep(0.05)
         try:
             stored = _counts(db_url)["RunResult"]
         except Exception:  # noqa: BLE001 - the schema may not exist yet
