@@ -10,7 +10,8 @@ Seeds used while tuning the budget: virtual 101, 102; second rig 201 (for the op
 term, 101 and 201 alone; for the zero's age between stated bounds, 201, 245 and 246).
 Reported here, fresh since that tuning: virtual 147 and 148, second rig 247 and 248 (quick:
 60 runs of the first seed each; 141-146 and 241-246 were earlier rounds' fresh seeds and
-have been looked at). Other seeds: edit ``SEEDS``, or call
+have been looked at; 149 and 150 were development seeds of the diagnosis of virtual load
+and slip, docs/run-results.md). Other seeds: edit ``SEEDS``, or call
 ``validation.coverage.run_coverage(folder, generator, runs, seed)``. Coverage comes with its
 Wilson 95 % interval (200 runs: about +-3 points at 95 %).
 """
