@@ -287,7 +287,10 @@ def zero_at_window(rests: RestReadings | None, column: str, window_s: tuple[floa
     reference = b.stats.mean if rest_value is None else rest_value
     d0, d1 = b.stats.mean - reference, a.stats.mean - reference
     zero = d0 + (d1 - d0) * w
-    means = _rss([Term((1 - w) * b.stats.se, max(b.stats.n_eff - 1, 1)),
+    # the zero is (1 - w) d0 + w d1; fz's d0 = 0 is the first rest itself, so its zero
+    # w (mean_after - mean_before) carries the first rest's noise with weight w, not 1 - w
+    w_before = (1 - w) if rest_value is not None else w
+    means = _rss([Term(w_before * b.stats.se, max(b.stats.n_eff - 1, 1)),
                   Term(w * a.stats.se, max(a.stats.n_eff - 1, 1))])
     beta = bridge_factor((window_s[0] - b.t_s) / span, (window_s[1] - b.t_s) / span)
     age = 0.0 if rest_value is not None else zero_age_mean_s + max(b.t_s, 0.0)

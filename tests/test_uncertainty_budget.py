@@ -137,6 +137,35 @@ def test_rest_readings_recover_a_linear_zero_drift():
     assert zero_at_window(None, "dp_n", (20.0, 40.0), 0.0).part is None
 
 
+def test_the_rests_noise_enters_the_zero_with_the_weights_of_its_line():
+    """No drift, rests of SE 0.1 N (before, 1 s) and 0.02 N (after, 41 s), a window whose
+    middle is a quarter of the way (w = 0.25). The DP cell's zero, ``(1 - w) d0 + w d1``,
+    spreads over 20,000 drawn rest means by ``hypot(0.75 * 0.1, 0.25 * 0.02)`` = 0.0752 N;
+    fz's, ``w (d1 - d0)`` (its line starts at the first rest), by ``0.25 * hypot(0.1, 0.02)``
+    = 0.0255 N: the rests' term of each must be that spread."""
+    from run_results.rest_readings import Rest, RestReadings
+    from run_results.stats import QuantityStats
+
+    rng = np.random.default_rng(31)
+    se_before, se_after, load_n = 0.1, 0.02, 150.0
+
+    def rests(before: float, after: float) -> RestReadings:
+        rest = {c: (Rest(1.0, QuantityStats(before + v, 0.0, se_before, 100, 100.0, "N")),
+                    Rest(41.0, QuantityStats(after + v, 0.0, se_after, 100, 100.0, "N")))
+                for c, v in (("dp_n", 0.0), ("fz_n", load_n))}
+        return RestReadings((2.0, 40.0), {c: b for c, (b, _) in rest.items()},
+                            {c: a for c, (_, a) in rest.items()})
+
+    window_s = (8.0, 14.0)                           # middle 11 s: w = (11 - 1) / 40
+    draws = [rests(*rng.normal(0.0, (se_before, se_after))) for _ in range(20_000)]
+    for column, rest_value, expected in (("dp_n", 0.0, math.hypot(0.75 * 0.1, 0.25 * 0.02)),
+                                         ("fz_n", None, 0.25 * math.hypot(0.1, 0.02))):
+        zeros = [zero_at_window(r, column, window_s, rest_value).zero for r in draws]
+        term = zero_at_window(draws[0], column, window_s, rest_value).part.means
+        assert term.u == pytest.approx(expected)
+        assert np.std(zeros) == pytest.approx(term.u, rel=0.03)
+
+
 def test_pooled_diffusion_of_random_walk_drifts():
     """Cells drifting as random walks of 0.05 N^2/s: the pooled D^2/T comes back."""
     rng = np.random.default_rng(9)
