@@ -29,8 +29,7 @@ from run_results.phase_average import phase_average
 from run_results.plausibility import plausibility_flags
 from run_results.rest_readings import rest_readings
 from run_results.result import RunResult
-from run_results.stats import (QuantityStats, batch_means_se, pitch_batch_means_se,
-                               quantity_stats)
+from run_results.stats import QuantityStats, batch_means_se, pitch_batches, quantity_stats
 from run_results.traces import run_traces
 from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
@@ -180,7 +179,8 @@ def process_run(run, params: StablePhaseParams | None = None,
     lo, hi = int(np.searchsorted(t, window.start_s)), int(np.searchsorted(t, window.end_s)) + 1
     oscillation, frequency = _oscillation(run, t, lo, hi, series)
     quantities, batches = {}, {}
-    pitch = round(1.0 / (frequency * float(np.median(np.diff(t[lo:hi]))))) if frequency else 0
+    dt_s = float(np.median(np.diff(t[lo:hi])))
+    pitch = round(1.0 / (frequency * dt_s)) if frequency else 0
     for key, (y, unit) in series.items():
         average = None
         if frequency and np.isfinite(y[lo:hi]).sum() > 16:
@@ -192,7 +192,7 @@ def process_run(run, params: StablePhaseParams | None = None,
                 batches[key] = batch_means_se(y[lo:hi], None if average is None
                                               else average["periodic"])
             elif average is not None:
-                batches[key] = pitch_batch_means_se(y[lo:hi], pitch, average["periodic"])
+                batches[key] = pitch_batches(y[lo:hi], pitch, average["periodic"], dt_s)
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     quantities.update({k: v for k, v in native.items() if k in quantities})

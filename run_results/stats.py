@@ -111,6 +111,61 @@ def _obm_var(y: np.ndarray, batch: int) -> float:
     return m * float(d @ d) / ((n - m + 1) * (n - m))
 
 
+@dataclass(frozen=True)
+class PitchBatches:
+    """Overlapping batch-means variances ``var`` of a window of ``n`` samples ``dt_s`` apart
+    in batches of 1, 2, ... whole pitches of ``pitch`` samples, and ``var_sample`` in
+    batches of one sample (``s^2/n``, the SE of independent samples) (:func:`pitch_batches`)."""
+
+    n: int
+    pitch: int
+    dt_s: float
+    var: tuple[float, ...]
+    var_sample: float
+
+    def se(self, walk_per_s: float = 0.0) -> tuple[float, float]:
+        """``(se, dof)`` of the window mean (:func:`pitch_batch_means_se`), with a random walk
+        of diffusion ``walk_per_s`` (signal units^2 per s) in the signal left out: the walk's
+        wander inside the window adds ``s^2 L (n - L) / (6 n)`` (``s^2 = walk_per_s dt_s``
+        per sample) to the expected ``var_L`` (the batch mean less the window mean of a
+        Brownian path, averaged over the batch's position: ``E[var_L] = L/(n - L) E[d^2]``
+        with ``E[d^2] = s^2 (n - L)^2 / (6 n)``), which is taken from every ``var_L``
+        before the fit. The zero-drift term's bridge holds that wander already, so without
+        this it is counted twice. A walk's realised wander varies about its expectation by
+        about as much, so the fit of what is left often resolves nothing (the non-negative
+        fit then keeps part of the wander: tests); the SE of independent samples less the
+        walk's share (the same formula at ``L`` = 1) is then taken, a lower bound for noise
+        correlated positively."""
+        n, m = self.n, self.pitch
+        per_sample = max(walk_per_s, 0.0) * self.dt_s / (6.0 * n)
+        sizes = m * np.arange(1, len(self.var) + 1)
+        var = np.asarray(self.var) - per_sample * sizes * (n - sizes)
+        x = 1.0 / ((n - sizes) * sizes)
+        estimate = float(var.mean())
+        if np.ptp(x) > 0:
+            (a, c), _ = optimize.nnls(np.column_stack([np.ones(x.size), x]), var)
+            estimate = a + c / n**2
+        if not estimate > 0:
+            estimate = self.var_sample - per_sample * (n - 1)
+        return float(np.sqrt(max(estimate, 0.0))), 1.5 * (n / m - 1.0)
+
+
+def pitch_batches(y, pitch: int, periodic=None, dt_s: float = 1.0) -> PitchBatches | None:
+    """The whole-pitch overlapping batch-means variances of ``y`` less its ``periodic`` part
+    (:func:`pitch_batch_means_se`); None with fewer than two pitches or a pitch under 2
+    samples."""
+    y = np.asarray(y, float)
+    if periodic is not None:
+        y = y - np.nan_to_num(np.asarray(periodic, float))
+    y = y[np.isfinite(y)]
+    n, m = y.size, int(pitch)
+    if m < 2 or n < 2 * m:
+        return None
+    sizes = m * np.arange(1, max(n // m - 1, 1) + 1)
+    return PitchBatches(n, m, float(dt_s), tuple(_obm_var(y, int(size)) for size in sizes),
+                        _obm_var(y, 1))
+
+
 def pitch_batch_means_se(y, pitch: int, periodic=None) -> tuple[float, float] | None:
     """``(se, dof)`` of the window mean of a signal carrying a wave that averages to zero
     over each grouser pitch but wanders in phase (``y`` less its phase-averaged ``periodic``
@@ -132,18 +187,5 @@ def pitch_batch_means_se(y, pitch: int, periodic=None) -> tuple[float, float] | 
     Schmeiser 1984). With two or three pitches (one value of ``(n - L) L``), the mean of
     their ``var_L``: plain overlapping batch means. None with fewer than two pitches or a
     pitch under 2 samples."""
-    y = np.asarray(y, float)
-    if periodic is not None:
-        y = y - np.nan_to_num(np.asarray(periodic, float))
-    y = y[np.isfinite(y)]
-    n, m = y.size, int(pitch)
-    if m < 2 or n < 2 * m:
-        return None
-    sizes = m * np.arange(1, max(n // m - 1, 1) + 1)
-    var = np.array([_obm_var(y, int(size)) for size in sizes])
-    x = 1.0 / ((n - sizes) * sizes)
-    estimate = float(var.mean())
-    if np.ptp(x) > 0:
-        (a, c), _ = optimize.nnls(np.column_stack([np.ones(x.size), x]), var)
-        estimate = a + c / n**2
-    return float(np.sqrt(estimate)), 1.5 * (n / m - 1.0)
+    batches = pitch_batches(y, pitch, periodic)
+    return None if batches is None else batches.se()

@@ -69,7 +69,7 @@ from scipy import optimize, special
 from run_results.native import MIN_SAMPLES_PER_BIN, channel_samples, hub_samples
 from run_results.phase_average import phase_average
 from run_results.rest_readings import RestReadings, resolution
-from run_results.stats import QuantityStats
+from run_results.stats import PitchBatches, QuantityStats
 from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
 
 #: quantity -> (load-cell column, divide by the wheel radius?) for the single-cell quantities
@@ -159,13 +159,33 @@ class DriftPart:
     change: float
     age_s: float = 0.0
 
+    def diffusion(self, pooled: dict[str, Term]) -> Term:
+        """The cell's drift diffusion (per s): the campaign's pooled one where given, else
+        the run's own ``D^2 / T`` (one degree of freedom)."""
+        return pooled.get(self.column, Term(self.change**2 / self.span_s, 1.0))
+
     def term(self, diffusion: dict[str, Term]) -> Term:
         """The zero-drift term, with the cell's pooled diffusion (per s) where given."""
-        own = Term(self.change**2 / self.span_s, 1.0)
-        sigma2 = diffusion.get(self.column, own)
+        sigma2 = self.diffusion(diffusion)
         walk = (self.beta * self.span_s + self.age_s) * max(sigma2.u, 0.0)
         return _rss([Term(abs(self.weight) * self.means.u, self.means.dof),
                      Term(abs(self.weight) * math.sqrt(walk), sigma2.dof)])
+
+
+@dataclass(frozen=True)
+class BatchStatistical:
+    """A statistical term from whole-pitch batch means (``run_results.stats.PitchBatches``),
+    ``fallback`` (the autocorrelation SE) where they resolve nothing."""
+
+    batches: PitchBatches
+    fallback: Term
+
+    def term(self, walk_per_s: float = 0.0) -> Term:
+        """With the load cells' drift, a walk of ``walk_per_s`` (quantity units^2 per s) in
+        the signal, left out of the batch means: the zero-drift term's bridge holds its
+        wander inside the window (module doc)."""
+        se, dof = self.batches.se(walk_per_s)
+        return Term(se, dof) if se > 0 else self.fallback
 
 
 @dataclass(frozen=True)
@@ -173,7 +193,8 @@ class QuantityBudget:
     """One quantity's budget: the correction added to the window mean, the terms, what was
     not measured, and the combined, effective-dof, coverage factor and expanded values.
     ``drift``: the load cells' zero parts, from which the ``zero_drift`` term is made with
-    ``diffusion`` (column -> pooled ``sigma^2`` per s as a :class:`Term`; empty: each run's own)."""
+    ``diffusion`` (column -> pooled ``sigma^2`` per s as a :class:`Term`; empty: each run's own);
+    ``batches``: where given, the ``statistical`` term, with the same drift's walk left out."""
 
     unit: str
     correction: float
@@ -181,15 +202,19 @@ class QuantityBudget:
     not_measured: tuple[str, ...] = ()
     drift: tuple[DriftPart, ...] = ()
     diffusion: dict[str, Term] = field(default_factory=dict)
+    batches: BatchStatistical | None = None
     u: float = field(init=False)
     dof: float = field(init=False)
     k: float = field(init=False)
 
     def __post_init__(self) -> None:
+        terms = dict(self.terms)
         if self.drift:
-            terms = {k: t for k, t in self.terms.items() if k != "zero_drift"}
             terms["zero_drift"] = _rss([p.term(self.diffusion) for p in self.drift])
-            object.__setattr__(self, "terms", terms)
+        if self.batches is not None:
+            walk = sum(p.weight**2 * max(p.diffusion(self.diffusion).u, 0.0) for p in self.drift)
+            terms["statistical"] = self.batches.term(walk)
+        object.__setattr__(self, "terms", terms)
         u, dof, k = combine(list(self.terms.values()))
         object.__setattr__(self, "u", u)
         object.__setattr__(self, "dof", dof)
@@ -344,7 +369,7 @@ def _statistical(s: QuantityStats) -> Term:
 
 def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
                  frequency_hz: float | None, params: BudgetParams,
-                 batch: tuple[float, float] | None) -> QuantityBudget:
+                 batch: PitchBatches | None) -> QuantityBudget:
     """Budget of a single-cell quantity (thrust: the torque cell over the radius)."""
     column, per_radius = CELL_OF[key]
     scale = run.metadata.wheel.radius_m if per_radius else 1.0
@@ -355,7 +380,7 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
     if z.part is not None and not absolute and params.zero_age_s is None:
         missing.append("fz zero drift since the zeroing (zero_age_s not stated in "
                        "swtlab.toml [uncertainty])")
-    terms = {"statistical": _batch_statistical(s, batch)}
+    terms = {"statistical": _statistical(s)}
     drift = () if z.part is None else (replace(z.part, weight=1.0 / scale),)
     mean = s.mean - z.zero / scale
     gain_u, offset_u = run.metadata.calibration_u.get(FIELD_OF[column], (None, None))
@@ -370,13 +395,14 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
         sampling = phase_sampling(native[0], native[1] / scale, frequency_hz)
         if sampling is not None:
             terms["phase_sampling"] = sampling
-    return QuantityBudget(s.unit, -z.zero / scale, terms, tuple(missing), drift)
+    return QuantityBudget(s.unit, -z.zero / scale, terms, tuple(missing), drift,
+                          batches=_batch_statistical(s, batch))
 
 
 def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]],
-                batch: tuple[float, float] | None) -> QuantityBudget:
+                batch: PitchBatches | None) -> QuantityBudget:
     """Budget of ``sum(sign * part)`` with its own statistical term (cells independent)."""
-    terms = {"statistical": _batch_statistical(s, batch)}
+    terms = {"statistical": _statistical(s)}
     for name in ("calibration", "quantisation", "phase_sampling"):
         found = [Term(abs(sign) * b.terms[name].u, b.terms[name].dof) for b, sign in parts
                  if name in b.terms]
@@ -385,13 +411,13 @@ def _sum_budget(s: QuantityStats, parts: list[tuple[QuantityBudget, float]],
     drift = tuple(replace(p, weight=sign * p.weight) for b, sign in parts for p in b.drift)
     missing = tuple(sorted({m for b, _ in parts for m in b.not_measured}))
     return QuantityBudget(s.unit, sum(sign * b.correction for b, sign in parts), terms,
-                          missing, drift)
+                          missing, drift, batches=_batch_statistical(s, batch))
 
 
-def _batch_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
-    """The batch-means statistical term, the autocorrelation one where it has none or
-    resolved nothing."""
-    return _statistical(s) if batch is None or not batch[0] > 0 else Term(*batch)
+def _batch_statistical(s: QuantityStats, batch: PitchBatches | None) -> BatchStatistical | None:
+    """The whole-pitch batch-means statistical term, the autocorrelation one where they
+    resolve nothing; None without batches (the autocorrelation term alone)."""
+    return None if batch is None else BatchStatistical(batch, _statistical(s))
 
 
 def _rate_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
@@ -419,8 +445,9 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
                frequency_hz: float | None = None) -> tuple[dict[str, QuantityStats],
                                                            dict[str, QuantityBudget]]:
     """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
-    re-zeroing correction added (module doc); ``batches``: the batch-means ``(se, dof)``
-    (``run_results.stats.batch_means_se``, ``pitch_batch_means_se``); ``frequency_hz``: the
+    re-zeroing correction added (module doc); ``batches``: the rates' batch-means ``(se,
+    dof)`` (``run_results.stats.batch_means_se``), the other grousered quantities'
+    ``run_results.stats.PitchBatches``; ``frequency_hz``: the
     grouser passing frequency (None: no grousers)."""
     params = params or BudgetParams()
     batches = batches or {}
@@ -460,10 +487,10 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
 
 def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict,
                    frequency_hz: float | None,
-                   batch: tuple[float, float] | None) -> QuantityBudget:
+                   batch: PitchBatches | None) -> QuantityBudget:
     """Hub height: statistics and the arm encoder's quantisation; sinkage of a flexible wheel
     also the wheel load's zero and calibration through ``fz / (1000 k)``."""
-    terms = {"statistical": _batch_statistical(s, batch)}
+    terms = {"statistical": _statistical(s)}
     hub = hub_samples(run, *window_s)
     if hub is not None:
         terms["quantisation"] = Term(_quantisation(resolution(hub[1]), s.std))
@@ -471,14 +498,16 @@ def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict,
         if sampling is not None:
             terms["phase_sampling"] = sampling
     stiffness = run.metadata.wheel.stiffness_n_per_mm
+    batches = _batch_statistical(s, batch)
     if key == "hub_height_m" or stiffness is None or "wheel_load_n" not in budgets:
-        return QuantityBudget(s.unit, 0.0, terms)
+        return QuantityBudget(s.unit, 0.0, terms, batches=batches)
     load = budgets["wheel_load_n"]
     scale = -1.0 / (1000.0 * stiffness)
     if "calibration" in load.terms:
         terms["calibration"] = Term(load.terms["calibration"].u * abs(scale))
     return QuantityBudget(s.unit, load.correction * scale, terms, load.not_measured,
-                          tuple(replace(p, weight=scale * p.weight) for p in load.drift))
+                          tuple(replace(p, weight=scale * p.weight) for p in load.drift),
+                          batches=batches)
 
 
 def with_diffusion(budgets: dict[str, QuantityBudget],
