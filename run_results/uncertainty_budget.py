@@ -14,7 +14,9 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   means with the wave's end effect separated (``run_results.stats.pitch_batch_means_se``):
   a real grouser wave wanders in phase (passage by passage) but averages to zero over each
   pitch, so it reaches the window mean only at the window's ends, while batch means count
-  it at every batch end.
+  it at every batch end. The load cells' drift inside the window, a walk whose window mean
+  the ``zero_drift`` bridge below already holds, is left out of these batch means once its
+  diffusion is known (:class:`BatchStatistical`, ``run_results.stats.PitchBatches.se``).
 - ``zero_drift``: the load cells' zero at the window, from the rest readings
   (``run_results.rest_readings``). DP, torque and side force read zero at rest; the zero is
   taken as linear in time between the two rests and subtracted (the ``correction``, GUM
