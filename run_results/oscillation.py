@@ -18,30 +18,58 @@ MAX_GRID = 2000      # grid points over the band at most (a window of ~1000 peri
 GRID_SAMPLES_PER_CYCLE = 16  # block means per cycle of the highest harmonic in the grid stage
 
 
-def _design(t_s: np.ndarray, frequency_hz: np.ndarray, harmonics: int) -> np.ndarray:
-    """Regressors ``[1, t - mean, cos k phi, sin k phi]`` (k = 1..harmonics) as rows, one set
-    per frequency: shape (frequencies, 2 harmonics + 2, samples). The harmonics are powers of
-    ``exp(i phi)`` (one complex exponential per sample and frequency, not one cos and one
-    sin per harmonic)."""
+def _normal_equations(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
+                      harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+    """Normal equations ``(A A^T, A y)`` of the regressors ``[1, t - mean, cos k phi,
+    sin k phi]`` (k = 1..harmonics), one set per frequency: shapes (frequencies, 2 harmonics
+    + 2, 2 harmonics + 2) and (frequencies, 2 harmonics + 2), without forming ``A``.
+
+    Every product of two harmonics is a sum of ``S_m = sum exp(i m phi)``, m = 0..2
+    harmonics (``cos j cos k = (cos(j-k) + cos(j+k))/2`` and its kin), so one complex power
+    per sample, frequency and m replaces the design's ``(2 harmonics + 2)^2`` products."""
+    h = harmonics
+    t_c = t_s - t_s.mean()
     rotation = np.exp(2j * np.pi * np.asarray(frequency_hz, float)[:, None] * (t_s - t_s[0]))
-    a = np.empty((rotation.shape[0], 2 * harmonics + 2, t_s.size))
-    a[:, 0] = 1.0
-    a[:, 1] = t_s - t_s.mean()
+    sums = np.empty((rotation.shape[0], 2 * h + 1), complex)      # S_m, m = 0..2h
+    moments = np.empty((rotation.shape[0], h, 2), complex)       # sum (t - mean, y) e^{ikphi}
+    sums[:, 0] = t_s.size
+    columns = np.stack([t_c, y], axis=1).astype(complex)
     power = rotation
-    for k in range(harmonics):
-        if k:
+    for m in range(1, 2 * h + 1):
+        if m > 1:
             power = power * rotation
-        a[:, 2 + k], a[:, 2 + harmonics + k] = power.real, power.imag
-    return a
+        sums[:, m] = power.sum(axis=1)
+        if m <= h:
+            moments[:, m - 1] = power @ columns
+    j, k = np.meshgrid(np.arange(1, h + 1), np.arange(1, h + 1), indexing="ij")
+    diff, total = sums[:, np.abs(j - k)], sums[:, j + k]
+    diff_imag = np.sign(k - j) * diff.imag                       # Im S_{k-j}, S_{-m} = conj S_m
+    gram = np.empty((rotation.shape[0], 2 * h + 2, 2 * h + 2))
+    gram[:, 0, 0], gram[:, 0, 1], gram[:, 1, 1] = t_s.size, t_c.sum(), t_c @ t_c
+    gram[:, 0, 2:2 + h], gram[:, 0, 2 + h:] = sums[:, 1:h + 1].real, sums[:, 1:h + 1].imag
+    gram[:, 1, 2:2 + h], gram[:, 1, 2 + h:] = moments[:, :, 0].real, moments[:, :, 0].imag
+    gram[:, 2:2 + h, 2:2 + h] = 0.5 * (diff.real + total.real)   # cos j cos k
+    gram[:, 2 + h:, 2 + h:] = 0.5 * (diff.real - total.real)     # sin j sin k
+    gram[:, 2:2 + h, 2 + h:] = 0.5 * (total.imag + diff_imag)    # cos j sin k
+    upper = np.triu_indices(2 * h + 2, 1)
+    gram[:, upper[1], upper[0]] = gram[:, upper[0], upper[1]]
+    rhs = np.empty((rotation.shape[0], 2 * h + 2))
+    rhs[:, 0], rhs[:, 1] = y.sum(), t_c @ y
+    rhs[:, 2:2 + h], rhs[:, 2 + h:] = moments[:, :, 1].real, moments[:, :, 1].imag
+    return gram, rhs
 
 
 def _fits(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
           harmonics: int) -> tuple[np.ndarray, np.ndarray]:
     """Coefficients (frequencies, 2 harmonics + 2) and residual sums of squares of the
-    least-squares series at each frequency (normal equations: 2k+2 unknowns)."""
-    a = _design(t_s, frequency_hz, harmonics)
-    coef = np.linalg.solve(a @ a.transpose(0, 2, 1), (a @ y)[:, :, None])
-    return coef[:, :, 0], np.sum((y - (coef.transpose(0, 2, 1) @ a)[:, 0]) ** 2, axis=1)
+    least-squares series at each frequency (normal equations: 2k+2 unknowns; the RSS as
+    ``|y - mean|^2 - b^T coef`` of the mean-free ``y``, which the constant absorbs)."""
+    mean = float(np.mean(y))
+    gram, rhs = _normal_equations(t_s, y - mean, frequency_hz, harmonics)
+    coef = np.linalg.solve(gram, rhs[:, :, None])[:, :, 0]
+    rss = np.sum((y - mean) ** 2) - np.sum(rhs * coef, axis=1)
+    coef[:, 0] += mean
+    return coef, rss
 
 
 def harmonic_fit(t_s, y, frequency_hz: float, harmonics: int = HARMONICS) -> dict:
