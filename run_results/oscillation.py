@@ -18,18 +18,32 @@ MAX_GRID = 2000      # grid points over the band at most (a window of ~1000 peri
 GRID_SAMPLES_PER_CYCLE = 16  # block means per cycle of the highest harmonic in the grid stage
 
 
-def _normal_equations(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
+def _rotations(t_s: np.ndarray, frequency_hz: np.ndarray, evenly_spaced: bool) -> np.ndarray:
+    """``exp(2 pi i f (t - t_0))``, one row per frequency. Evenly spaced frequencies: the
+    first row and the step's factor by ``exp``, the other rows as running products of them
+    (a complex exponential costs ~15 products; the rounding grows ~1e-16 a row)."""
+    u = t_s - t_s[0]
+    f = np.asarray(frequency_hz, float)
+    if not evenly_spaced or f.size < 3:
+        return np.exp(2j * np.pi * f[:, None] * u)
+    rows = np.empty((f.size, u.size), complex)
+    rows[0] = np.exp(2j * np.pi * f[0] * u)
+    rows[1:] = np.exp(2j * np.pi * ((f[-1] - f[0]) / (f.size - 1)) * u)
+    return np.cumprod(rows, axis=0, out=rows)
+
+
+def _normal_equations(t_s: np.ndarray, y: np.ndarray, rotation: np.ndarray,
                       harmonics: int) -> tuple[np.ndarray, np.ndarray]:
     """Normal equations ``(A A^T, A y)`` of the regressors ``[1, t - mean, cos k phi,
-    sin k phi]`` (k = 1..harmonics), one set per frequency: shapes (frequencies, 2 harmonics
-    + 2, 2 harmonics + 2) and (frequencies, 2 harmonics + 2), without forming ``A``.
+    sin k phi]`` (k = 1..harmonics), one set per row of ``rotation`` (``exp(i phi)``): shapes
+    (frequencies, 2 harmonics + 2, 2 harmonics + 2) and (frequencies, 2 harmonics + 2),
+    without forming ``A``.
 
     Every product of two harmonics is a sum of ``S_m = sum exp(i m phi)``, m = 0..2
     harmonics (``cos j cos k = (cos(j-k) + cos(j+k))/2`` and its kin), so one complex power
     per sample, frequency and m replaces the design's ``(2 harmonics + 2)^2`` products."""
     h = harmonics
     t_c = t_s - t_s.mean()
-    rotation = np.exp(2j * np.pi * np.asarray(frequency_hz, float)[:, None] * (t_s - t_s[0]))
     sums = np.empty((rotation.shape[0], 2 * h + 1), complex)      # S_m, m = 0..2h
     moments = np.empty((rotation.shape[0], h, 2), complex)       # sum (t - mean, y) e^{ikphi}
     sums[:, 0] = t_s.size
@@ -59,13 +73,14 @@ def _normal_equations(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
     return gram, rhs
 
 
-def _fits(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
-          harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+def _fits(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray, harmonics: int,
+          evenly_spaced: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Coefficients (frequencies, 2 harmonics + 2) and residual sums of squares of the
     least-squares series at each frequency (normal equations: 2k+2 unknowns; the RSS as
     ``|y - mean|^2 - b^T coef`` of the mean-free ``y``, which the constant absorbs)."""
     mean = float(np.mean(y))
-    gram, rhs = _normal_equations(t_s, y - mean, frequency_hz, harmonics)
+    gram, rhs = _normal_equations(t_s, y - mean,
+                                  _rotations(t_s, frequency_hz, evenly_spaced), harmonics)
     coef = np.linalg.solve(gram, rhs[:, :, None])[:, :, 0]
     rss = np.sum((y - mean) ** 2) - np.sum(rhs * coef, axis=1)
     coef[:, 0] += mean
@@ -110,7 +125,7 @@ def measure_frequency_hz(t_s, y, expected_hz: float, harmonics: int = HARMONICS)
     t_grid = t_s[:n].reshape(-1, block).mean(axis=1)
     y_grid = y[:n].reshape(-1, block).mean(axis=1)
     per_batch = max(1, BATCH_ELEMENTS // (t_grid.size * (2 * harmonics + 2)))
-    rss = np.concatenate([_fits(t_grid, y_grid, grid[i:i + per_batch], harmonics)[1]
+    rss = np.concatenate([_fits(t_grid, y_grid, grid[i:i + per_batch], harmonics, True)[1]
                           for i in range(0, grid.size, per_batch)])
     best = float(grid[int(np.argmin(rss))])
     width = grid[1] - grid[0]
