@@ -44,27 +44,14 @@ def _exponential(t, a, b, tau, t0):
     return a + b * np.exp(-np.clip(t - t0, 0.0, None) / tau)
 
 
-def _exponential_jac(t, a, b, tau, t0):
-    """d/d(a, b, tau, t0) of :func:`_exponential` (columns)."""
-    s = np.clip(t - t0, 0.0, None)
-    e = np.exp(-s / tau)
-    return np.column_stack([np.ones_like(t), e, b * e * s / tau**2, b * e / tau * (s > 0)])
-
-
 def _repeated_pole(t, a, b, c, tau, t0):
     x = np.clip(t - t0, 0.0, None) / tau
     return a + (b + c * x) * np.exp(-x)
 
 
-#: Jacobians: the plain exponential's analytic (one evaluation per step instead of one per
-#: parameter); the double pole's by finite differences (with its analytic Jacobian the
-#: critically damped test case ends in another local minimum, onset 3.9 s for 3.0 s)
-JACOBIANS = {_exponential: _exponential_jac, _repeated_pole: "2-point"}
-
-
 def _fit(model, t, y, p0, lower, upper):
     try:
-        p, _ = curve_fit(model, t, y, p0=p0, bounds=(lower, upper), jac=JACOBIANS[model])
+        p, _ = curve_fit(model, t, y, p0=p0, bounds=(lower, upper))
     except (RuntimeError, ValueError):
         return None
     return p, float(np.std(y - model(t, *p)))
