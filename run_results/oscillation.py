@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from swtlab.order_stats import median
+
 HARMONICS = 6
 SEARCH_RATIO = 0.4   # look for the frequency within +-40 % of the expected one
 MAX_GRID = 2000      # grid points over the band at most (a window of ~1000 periods)
@@ -119,7 +121,7 @@ def measure_frequency_hz(t_s, y, expected_hz: float, harmonics: int = HARMONICS)
     step = 1.0 / (4.0 * harmonics * (t_s[-1] - t_s[0]))
     lo, hi = (1.0 - SEARCH_RATIO) * expected_hz, (1.0 + SEARCH_RATIO) * expected_hz
     grid = np.linspace(lo, hi, min(MAX_GRID, int(np.ceil((hi - lo) / step)) + 1))
-    samples_per_cycle = 1.0 / (hi * harmonics * float(np.median(np.diff(t_s))))
+    samples_per_cycle = 1.0 / (hi * harmonics * float(median(np.diff(t_s))))
     block = max(1, int(samples_per_cycle // GRID_SAMPLES_PER_CYCLE))
     n = t_s.size // block * block
     t_grid = t_s[:n].reshape(-1, block).mean(axis=1)

@@ -36,6 +36,7 @@ from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
 from swtlab.domain.results import wheel_columns
+from swtlab.order_stats import median
 
 FORCE_CHANNELS = ("fx_n", "fy_n", "fz_n", "tx_nm", "ty_nm", "tz_nm", "dp_n")
 #: a measured passing frequency this far from n*omega/2pi is flagged
@@ -180,7 +181,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     lo, hi = int(np.searchsorted(t, window.start_s)), int(np.searchsorted(t, window.end_s)) + 1
     oscillation, frequency = _oscillation(run, t, lo, hi, series)
     quantities, batches = {}, {}
-    pitch = round(1.0 / (frequency * float(np.median(np.diff(t[lo:hi]))))) if frequency else 0
+    pitch = round(1.0 / (frequency * float(median(np.diff(t[lo:hi]))))) if frequency else 0
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     phase = phase_bins(t[lo:hi], frequency) if frequency else None

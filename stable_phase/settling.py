@@ -123,7 +123,7 @@ class SettlingDetector:
     double_pole = False
 
     def locate(self, t_s, signals, period_s, params, gate_start) -> Cut:
-        dt = float(np.median(np.diff(t_s)))
+        dt = float(median(np.diff(t_s)))
         width = max(int(round((period_s or params.batch_s) / dt)), 1)
         step = -(-t_s.size // FIT_POINTS)
         fits = {name: fit_settling(t_s[::step], moving_average(y, width, full_only=True)[::step],
