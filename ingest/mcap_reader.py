@@ -95,21 +95,16 @@ def _plain_blocks(data: list[bytes]) -> RawTopic | None:
             block = orjson.loads(message)
         except orjson.JSONDecodeError:
             return None
-        if type(block) is not dict or "t_ns" not in block or not _whole_stamps(message):
+        if type(block) is not dict or "t_ns" not in block or not (
+                _numbers_only(message, len(block)) and _whole_stamps(message)):
             return None
         if not columns:
             columns = {name: [] for name in block}
         elif block.keys() != columns.keys():
             return None
-        arrays = {name: _number_floats(v) for name, v in block.items() if name != "t_ns"}
-        # array.array took only numbers (true/false among them); the bytes check otherwise
-        if (any(a is None for a in arrays.values()) or b"true" in message
-                or b"false" in message) and not _numbers_only(message, len(block)):
-            return None
         try:
-            arrays = {name: np.array(block[name], np.float64) if a is None else a
-                      for name, a in arrays.items()}
-            arrays["t_ns"] = np.array(block["t_ns"], np.int64)
+            arrays = {name: np.array(v, np.int64) if name == "t_ns" else _floats(v)
+                      for name, v in block.items()}
         except (ValueError, TypeError, OverflowError):  # a list or null among the samples,
             return None                                 # a number beyond int64/float64
         size = arrays["t_ns"].shape
@@ -129,16 +124,16 @@ def _plain_blocks(data: list[bytes]) -> RawTopic | None:
                                                for name, parts in columns.items()})
 
 
-def _number_floats(values) -> np.ndarray | None:
-    """A JSON list of numbers as float64 through ``array.array`` (about twice as fast as
-    ``np.array`` on a list of Python floats, the same doubles); None if it holds anything
-    else (null, a list, a string: ``np.array`` and the checks decide)."""
-    if type(values) is not list:
-        return None
-    try:
-        return np.frombuffer(array.array("d", values), np.float64)
-    except (TypeError, OverflowError):
-        return None
+def _floats(values) -> np.ndarray:
+    """A JSON list of numbers as float64 (null as NaN): through ``array.array`` (about twice
+    as fast as ``np.array`` on a list of Python floats, the same doubles) unless it is no list
+    or holds something else, which ``np.array`` then converts or refuses."""
+    if type(values) is list:
+        try:
+            return np.frombuffer(array.array("d", values), np.float64)
+        except (TypeError, OverflowError):
+            pass
+    return np.array(values, np.float64)
 
 
 def _checked_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
