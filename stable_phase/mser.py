@@ -22,7 +22,7 @@ def batch_means(t_s: np.ndarray, y: np.ndarray, period_s: float | None,
     width = max(int(round((period_s or batch_s) / dt)), 1)
     step = max(int(round(batch_s / dt)), 1)
     centres = np.arange(0, t_s.size, step)
-    return centres, moving_average(y, width, full_only=True)[centres]
+    return centres, moving_average(y, width, full_only=True, at=centres)
 
 
 def mser_two_sided(means: np.ndarray, max_cut_fraction: float,
