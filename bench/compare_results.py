@@ -56,10 +56,13 @@ _QUANTITIES = ("SELECT f.path, q.quantity, q.mean, q.se, q.std, q.n, q.n_eff, u.
 def _numbers(value, path: str = "") -> dict[str, float]:
     """Numeric leaves of a JSON value by their path (list indices and keys)."""
     if isinstance(value, dict):
-        return {k: v for key, item in value.items() for k, v in _numbers(item, f"{path}.{key}").items()}
-    if isinstance(value, list):
-        return {k: v for i, item in enumerate(value) for k, v in _numbers(item, f"{path}[{i}]").items()}
-    return {path: float(value)} if isinstance(value, (int, float)) and not isinstance(value, bool) else {}
+        items = [(f"{path}.{key}", item) for key, item in value.items()]
+    elif isinstance(value, list):
+        items = [(f"{path}[{i}]", item) for i, item in enumerate(value)]
+    else:
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        return {path: float(value)} if number else {}
+    return {k: v for where, item in items for k, v in _numbers(item, where).items()}
 
 
 def shifts(old: str, new: str) -> None:
