@@ -7,6 +7,7 @@ block that may hold more than numbers goes through the sample-by-sample checks
 
 from __future__ import annotations
 
+import array
 import json
 from collections import defaultdict
 from itertools import chain
@@ -102,7 +103,7 @@ def _plain_blocks(data: list[bytes]) -> RawTopic | None:
         elif block.keys() != columns.keys():
             return None
         try:
-            arrays = {name: np.array(v, np.int64 if name == "t_ns" else np.float64)
+            arrays = {name: np.array(v, np.int64) if name == "t_ns" else _floats(v)
                       for name, v in block.items()}
         except (ValueError, TypeError, OverflowError):  # a list or null among the samples,
             return None                                 # a number beyond int64/float64
@@ -121,6 +122,18 @@ def _plain_blocks(data: list[bytes]) -> RawTopic | None:
         return None
     return RawTopic(t_s=t_ns * 1e-9, fields={name: np.concatenate([parts[i] for i in order])
                                                for name, parts in columns.items()})
+
+
+def _floats(values) -> np.ndarray:
+    """A JSON list of numbers as float64 (null as NaN): through ``array.array`` (about twice
+    as fast as ``np.array`` on a list of Python floats, the same doubles) unless it is no list
+    or holds something else, which ``np.array`` then converts or refuses."""
+    if type(values) is list:
+        try:
+            return np.frombuffer(array.array("d", values), np.float64)
+        except (TypeError, OverflowError):
+            pass
+    return np.array(values, np.float64)
 
 
 def _checked_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:

@@ -12,36 +12,81 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from swtlab.order_stats import median
+
 HARMONICS = 6
 SEARCH_RATIO = 0.4   # look for the frequency within +-40 % of the expected one
 MAX_GRID = 2000      # grid points over the band at most (a window of ~1000 periods)
 GRID_SAMPLES_PER_CYCLE = 16  # block means per cycle of the highest harmonic in the grid stage
 
 
-def _design(t_s: np.ndarray, frequency_hz: np.ndarray, harmonics: int) -> np.ndarray:
-    """Regressors ``[1, t - mean, cos k phi, sin k phi]`` (k = 1..harmonics) as rows, one set
-    per frequency: shape (frequencies, 2 harmonics + 2, samples). The harmonics are powers of
-    ``exp(i phi)`` (one complex exponential per sample and frequency, not one cos and one
-    sin per harmonic)."""
-    rotation = np.exp(2j * np.pi * np.asarray(frequency_hz, float)[:, None] * (t_s - t_s[0]))
-    a = np.empty((rotation.shape[0], 2 * harmonics + 2, t_s.size))
-    a[:, 0] = 1.0
-    a[:, 1] = t_s - t_s.mean()
+def _rotations(t_s: np.ndarray, frequency_hz: np.ndarray, evenly_spaced: bool) -> np.ndarray:
+    """``exp(2 pi i f (t - t_0))``, one row per frequency. Evenly spaced frequencies: the
+    first row and the step's factor by ``exp``, the other rows as running products of them
+    (a complex exponential costs ~15 products; the rounding grows ~1e-16 a row)."""
+    u = t_s - t_s[0]
+    f = np.asarray(frequency_hz, float)
+    if not evenly_spaced or f.size < 3:
+        return np.exp(2j * np.pi * f[:, None] * u)
+    rows = np.empty((f.size, u.size), complex)
+    rows[0] = np.exp(2j * np.pi * f[0] * u)
+    rows[1:] = np.exp(2j * np.pi * ((f[-1] - f[0]) / (f.size - 1)) * u)
+    return np.cumprod(rows, axis=0, out=rows)
+
+
+def _normal_equations(t_s: np.ndarray, y: np.ndarray, rotation: np.ndarray,
+                      harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+    """Normal equations ``(A A^T, A y)`` of the regressors ``[1, t - mean, cos k phi,
+    sin k phi]`` (k = 1..harmonics), one set per row of ``rotation`` (``exp(i phi)``): shapes
+    (frequencies, 2 harmonics + 2, 2 harmonics + 2) and (frequencies, 2 harmonics + 2),
+    without forming ``A``.
+
+    Every product of two harmonics is a sum of ``S_m = sum exp(i m phi)``, m = 0..2
+    harmonics (``cos j cos k = (cos(j-k) + cos(j+k))/2`` and its kin), so one complex power
+    per sample, frequency and m replaces the design's ``(2 harmonics + 2)^2`` products."""
+    h = harmonics
+    t_c = t_s - t_s.mean()
+    sums = np.empty((rotation.shape[0], 2 * h + 1), complex)      # S_m, m = 0..2h
+    moments = np.empty((rotation.shape[0], h, 2), complex)       # sum (t - mean, y) e^{ikphi}
+    sums[:, 0] = t_s.size
+    columns = np.stack([t_c, y], axis=1).astype(complex)
     power = rotation
-    for k in range(harmonics):
-        if k:
+    for m in range(1, 2 * h + 1):
+        if m > 1:
             power = power * rotation
-        a[:, 2 + k], a[:, 2 + harmonics + k] = power.real, power.imag
-    return a
+        sums[:, m] = power.sum(axis=1)
+        if m <= h:
+            moments[:, m - 1] = power @ columns
+    j, k = np.meshgrid(np.arange(1, h + 1), np.arange(1, h + 1), indexing="ij")
+    diff, total = sums[:, np.abs(j - k)], sums[:, j + k]
+    diff_imag = np.sign(k - j) * diff.imag                       # Im S_{k-j}, S_{-m} = conj S_m
+    gram = np.empty((rotation.shape[0], 2 * h + 2, 2 * h + 2))
+    gram[:, 0, 0], gram[:, 0, 1], gram[:, 1, 1] = t_s.size, t_c.sum(), t_c @ t_c
+    gram[:, 0, 2:2 + h], gram[:, 0, 2 + h:] = sums[:, 1:h + 1].real, sums[:, 1:h + 1].imag
+    gram[:, 1, 2:2 + h], gram[:, 1, 2 + h:] = moments[:, :, 0].real, moments[:, :, 0].imag
+    gram[:, 2:2 + h, 2:2 + h] = 0.5 * (diff.real + total.real)   # cos j cos k
+    gram[:, 2 + h:, 2 + h:] = 0.5 * (diff.real - total.real)     # sin j sin k
+    gram[:, 2:2 + h, 2 + h:] = 0.5 * (total.imag + diff_imag)    # cos j sin k
+    upper = np.triu_indices(2 * h + 2, 1)
+    gram[:, upper[1], upper[0]] = gram[:, upper[0], upper[1]]
+    rhs = np.empty((rotation.shape[0], 2 * h + 2))
+    rhs[:, 0], rhs[:, 1] = y.sum(), t_c @ y
+    rhs[:, 2:2 + h], rhs[:, 2 + h:] = moments[:, :, 1].real, moments[:, :, 1].imag
+    return gram, rhs
 
 
-def _fits(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray,
-          harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+def _fits(t_s: np.ndarray, y: np.ndarray, frequency_hz: np.ndarray, harmonics: int,
+          evenly_spaced: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Coefficients (frequencies, 2 harmonics + 2) and residual sums of squares of the
-    least-squares series at each frequency (normal equations: 2k+2 unknowns)."""
-    a = _design(t_s, frequency_hz, harmonics)
-    coef = np.linalg.solve(a @ a.transpose(0, 2, 1), (a @ y)[:, :, None])
-    return coef[:, :, 0], np.sum((y - (coef.transpose(0, 2, 1) @ a)[:, 0]) ** 2, axis=1)
+    least-squares series at each frequency (normal equations: 2k+2 unknowns; the RSS as
+    ``|y - mean|^2 - b^T coef`` of the mean-free ``y``, which the constant absorbs)."""
+    mean = float(np.mean(y))
+    gram, rhs = _normal_equations(t_s, y - mean,
+                                  _rotations(t_s, frequency_hz, evenly_spaced), harmonics)
+    coef = np.linalg.solve(gram, rhs[:, :, None])[:, :, 0]
+    rss = np.sum((y - mean) ** 2) - np.sum(rhs * coef, axis=1)
+    coef[:, 0] += mean
+    return coef, rss
 
 
 def harmonic_fit(t_s, y, frequency_hz: float, harmonics: int = HARMONICS) -> dict:
@@ -76,13 +121,13 @@ def measure_frequency_hz(t_s, y, expected_hz: float, harmonics: int = HARMONICS)
     step = 1.0 / (4.0 * harmonics * (t_s[-1] - t_s[0]))
     lo, hi = (1.0 - SEARCH_RATIO) * expected_hz, (1.0 + SEARCH_RATIO) * expected_hz
     grid = np.linspace(lo, hi, min(MAX_GRID, int(np.ceil((hi - lo) / step)) + 1))
-    samples_per_cycle = 1.0 / (hi * harmonics * float(np.median(np.diff(t_s))))
+    samples_per_cycle = 1.0 / (hi * harmonics * float(median(np.diff(t_s))))
     block = max(1, int(samples_per_cycle // GRID_SAMPLES_PER_CYCLE))
     n = t_s.size // block * block
     t_grid = t_s[:n].reshape(-1, block).mean(axis=1)
     y_grid = y[:n].reshape(-1, block).mean(axis=1)
     per_batch = max(1, BATCH_ELEMENTS // (t_grid.size * (2 * harmonics + 2)))
-    rss = np.concatenate([_fits(t_grid, y_grid, grid[i:i + per_batch], harmonics)[1]
+    rss = np.concatenate([_fits(t_grid, y_grid, grid[i:i + per_batch], harmonics, True)[1]
                           for i in range(0, grid.size, per_batch)])
     best = float(grid[int(np.argmin(rss))])
     width = grid[1] - grid[0]

@@ -226,7 +226,7 @@ def dig_in_flags(run, window, params) -> list[str]:
     flags = []
     period = grouser_period_s(run.metadata.wheel.grouser_count,
                               float(np.nanmedian(ch["wheel_omega_radps"].to_numpy()[start:stop])))
-    dt = float(np.median(np.diff(t)))
+    dt = float(median(np.diff(t)))
     width = max(int(round(max(period or 0.0, params.batch_s) / dt)), 1)
     dp = ch["dp_n"].to_numpy()
     if run.metadata.run.mode != "free_sled" and start - lo > width \

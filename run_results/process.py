@@ -25,7 +25,7 @@ import numpy as np
 from run_results import oscillation as osc
 from run_results.corrections import RigCompliance, corrected_heights, tare_record
 from run_results.native import native_quantities
-from run_results.phase_average import phase_average
+from run_results.phase_average import phase_average, phase_bins
 from run_results.plausibility import plausibility_flags
 from run_results.rest_readings import rest_readings
 from run_results.result import RunResult
@@ -35,6 +35,7 @@ from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
 from swtlab.domain.results import wheel_columns
+from swtlab.order_stats import median
 
 FORCE_CHANNELS = ("fx_n", "fy_n", "fz_n", "tx_nm", "ty_nm", "tz_nm", "dp_n")
 #: a measured passing frequency this far from n*omega/2pi is flagged
@@ -179,13 +180,19 @@ def process_run(run, params: StablePhaseParams | None = None,
     lo, hi = int(np.searchsorted(t, window.start_s)), int(np.searchsorted(t, window.end_s)) + 1
     oscillation, frequency = _oscillation(run, t, lo, hi, series)
     quantities, batches = {}, {}
-    dt_s = float(np.median(np.diff(t[lo:hi])))
+    dt_s = float(median(np.diff(t[lo:hi])))
     pitch = round(1.0 / (frequency * dt_s)) if frequency else 0
+    native, combined = native_quantities(run, window.start_s, window.end_s,
+                                         {k: u for k, (_, u) in series.items()}, frequency, rig)
+    phase = phase_bins(t[lo:hi], frequency) if frequency else None
     for key, (y, unit) in series.items():
         average = None
-        if frequency and np.isfinite(y[lo:hi]).sum() > 16:
-            average = phase_average(t[lo:hi], y[lo:hi], frequency)
-        stats = quantity_stats(y[lo:hi], unit, average)
+        finite = int(np.isfinite(y[lo:hi]).sum())
+        if frequency and finite > 16:
+            average = phase_average(t[lo:hi], y[lo:hi], frequency, phase)
+        # the native samples' stats replace the common grid's (their batches stay)
+        stats = (native[key] if finite >= 2 else None) if key in native else quantity_stats(
+            y[lo:hi], unit, average)
         if stats is not None:
             quantities[key] = stats
             if key in RATES:
@@ -193,9 +200,6 @@ def process_run(run, params: StablePhaseParams | None = None,
                                               else average["periodic"])
             elif average is not None:
                 batches[key] = pitch_batches(y[lo:hi], pitch, average["periodic"], dt_s)
-    native, combined = native_quantities(run, window.start_s, window.end_s,
-                                         {k: u for k, (_, u) in series.items()}, frequency, rig)
-    quantities.update({k: v for k, v in native.items() if k in quantities})
     quantities.update({k: replace(quantities[k], mean=v) for k, v in combined.items()
                        if k in quantities})
     corrections["hub_height_correction_mean_m"] = float(np.nanmean(applied["correction_m"][lo:hi]))

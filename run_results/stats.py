@@ -102,11 +102,12 @@ def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, flo
     return float(np.sqrt(max(var, 0.0))), dof
 
 
-def _obm_var(y: np.ndarray, batch: int) -> float:
+def _obm_var(sums: np.ndarray, batch: int) -> float:
     """Overlapping-batch-means estimate of ``var(mean)`` with batches of ``batch`` samples
-    (Meketon & Schmeiser 1984): ``m sum_j (ybar_j - ybar)^2 / ((n - m + 1)(n - m))``."""
-    n, m = y.size, batch
-    sums = np.cumsum(np.concatenate([[0.0], y - y.mean()]))
+    (Meketon & Schmeiser 1984): ``m sum_j (ybar_j - ybar)^2 / ((n - m + 1)(n - m))``;
+    ``sums``: the running sums of ``y - mean`` from 0 (``n + 1`` values, one for every batch
+    size)."""
+    n, m = sums.size - 1, batch
     d = (sums[m:] - sums[:-m]) / m
     return m * float(d @ d) / ((n - m + 1) * (n - m))
 
@@ -162,8 +163,9 @@ def pitch_batches(y, pitch: int, periodic=None, dt_s: float = 1.0) -> PitchBatch
     if m < 2 or n < 2 * m:
         return None
     sizes = m * np.arange(1, max(n // m - 1, 1) + 1)
-    return PitchBatches(n, m, float(dt_s), tuple(_obm_var(y, int(size)) for size in sizes),
-                        _obm_var(y, 1))
+    sums = np.cumsum(np.concatenate([[0.0], y - y.mean()]))
+    return PitchBatches(n, m, float(dt_s), tuple(_obm_var(sums, int(size)) for size in sizes),
+                        _obm_var(sums, 1))
 
 
 def pitch_batch_means_se(y, pitch: int, periodic=None) -> tuple[float, float] | None:

@@ -73,6 +73,7 @@ from run_results.phase_average import phase_average
 from run_results.rest_readings import RestReadings, resolution
 from run_results.stats import PitchBatches, QuantityStats
 from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
+from swtlab.order_stats import median
 
 #: quantity -> (load-cell column, divide by the wheel radius?) for the single-cell quantities
 CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),
@@ -361,7 +362,7 @@ def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -
     if wave.size < 2:
         return None
     drop = float(np.max(np.abs(np.diff(np.append(wave, wave[0])))))
-    per_period = 1.0 / (frequency_hz * float(np.median(np.diff(t_s))))
+    per_period = 1.0 / (frequency_hz * float(median(np.diff(t_s))))
     return Term(drop / (2.0 * per_period) / math.sqrt(3.0), rectangular=True)
 
 

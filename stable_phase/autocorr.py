@@ -23,17 +23,37 @@ def autocorrelation(x: np.ndarray) -> np.ndarray:
     return acov / acov[0] if acov[0] > 0 else np.zeros(n)
 
 
+#: lags summed directly (one dot product each) before the FFT of all lags is needed: the
+#: initial positive sequence of most window residuals ends within them
+DIRECT_LAGS = 16
+
+
+def _initial_sequence(rho: np.ndarray, every_lag: bool) -> np.ndarray | None:
+    """Geyer's pairs ``rho_2m + rho_2m+1`` before the first non-positive one, made monotone;
+    where none is non-positive: all pairs if ``rho`` has ``every_lag``, else None."""
+    pairs = rho[: 2 * (rho.size // 2)].reshape(-1, 2).sum(axis=1)
+    stop = np.flatnonzero(pairs <= 0)
+    if not stop.size and not every_lag:
+        return None
+    return np.minimum.accumulate(pairs[: stop[0] if stop.size else pairs.size])
+
+
 def statistical_inefficiency(x) -> float:
-    """``g`` >= 1/n by Geyer's initial monotone positive sequence (NaNs dropped)."""
+    """``g`` >= 1/n by Geyer's initial monotone positive sequence (NaNs dropped). The first
+    ``DIRECT_LAGS`` autocorrelations are summed directly; all lags by FFT only when the
+    sequence runs past them (same ``rho`` to rounding)."""
     x = np.asarray(x, float)
     x = x[np.isfinite(x)]
     if x.size < 4:
         return 1.0
-    rho = autocorrelation(x)
-    pairs = rho[: 2 * (rho.size // 2)].reshape(-1, 2).sum(axis=1)
-    positive = np.flatnonzero(pairs <= 0)
-    pairs = pairs[: positive[0] if positive.size else pairs.size]
-    pairs = np.minimum.accumulate(pairs)
+    pairs = None
+    centred = x - np.mean(x)
+    if x.size > 2 * DIRECT_LAGS:
+        acov = np.array([centred[:x.size - k] @ centred[k:] for k in range(DIRECT_LAGS)])
+        if acov[0] > 0:
+            pairs = _initial_sequence(acov / acov[0], every_lag=False)
+    if pairs is None:
+        pairs = _initial_sequence(autocorrelation(x), every_lag=True)
     g = -1.0 + 2.0 * pairs.sum()
     return float(max(g, 1.0 / x.size))
 

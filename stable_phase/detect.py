@@ -25,6 +25,7 @@ from stable_phase.params import StablePhaseParams
 from stable_phase.registry import get_detector
 from stable_phase.signals import grouser_period_s, moving_average
 from stable_phase.window import StableWindow
+from swtlab.order_stats import median
 
 #: signals the transient cut looks at, in order of preference, and those the checks test
 SETTLING = ("hub_height_m", "sinkage_m", "dp_n", "ty_nm")
@@ -74,7 +75,7 @@ def _check(t: np.ndarray, signals: dict, limits: dict, params: StablePhaseParams
 def _whole_periods(t: np.ndarray, start: int, stop: int, period_s: float | None) -> tuple[int, int]:
     if period_s is None or stop - start < 2:
         return start, stop
-    dt = float(np.median(np.diff(t)))
+    dt = float(median(np.diff(t)))
     periods = int(np.floor((stop - start) * dt / period_s))
     if periods < 1:
         return start, stop
@@ -89,7 +90,7 @@ def _no_stable_reason(run, t: np.ndarray, lo: int, hi: int, period_s: float | No
     still grows over the segment's second half (a settling transient has levelled off there).
     """
     ch = run.channels
-    dt = float(np.median(np.diff(t)))
+    dt = float(median(np.diff(t)))
     width = max(int(round((period_s or params.batch_s) / dt)), 1)
     parts = []
     z = moving_average(ch["sinkage_m"].to_numpy()[lo:hi], width, full_only=True)
@@ -161,7 +162,7 @@ def detect_stable_phase(run, params: StablePhaseParams | None = None) -> StableW
             run, t, lo, hi, period_s, params,
             f"{', '.join(drifting)} drift significantly over every candidate window"))
     diag["grouser_periods"] = None if period_s is None else float(
-        (t[stop - 1] - t[start] + np.median(np.diff(t))) / period_s)
+        (t[stop - 1] - t[start] + median(np.diff(t))) / period_s)
     diag["window_samples"] = int(stop - start)
     diag["shrunk_to_second_half"] = attempt != "window"
     r_hats = [c["r_hat"] for c in checks.values() if np.isfinite(c["r_hat"])]

@@ -28,6 +28,7 @@ import numpy as np
 
 from stable_phase.params import StablePhaseParams
 from stable_phase.signals import longest_true_run, moving_average, robust_sigma
+from swtlab.order_stats import median
 
 
 @dataclass(frozen=True)
@@ -57,7 +58,7 @@ def _plateau(x: np.ndarray, rel_tol: float) -> float:
     edges = np.arange(finite.min(), finite.max() + 2 * width, width)
     counts, edges = np.histogram(finite, edges)
     centre = edges[np.argmax(counts)] + width / 2
-    return float(np.median(finite[np.abs(finite - centre) <= width]))
+    return float(median(finite[np.abs(finite - centre) <= width]))
 
 
 def references(run, surface_mps: np.ndarray, velocity_mps: np.ndarray,
@@ -81,7 +82,7 @@ def speed_gate(run, params: StablePhaseParams) -> Gate:
     """Gate a run on its measured speeds (see module doc)."""
     ch = run.channels
     t = ch["t_s"].to_numpy()
-    rate_hz = 1.0 / float(np.median(np.diff(t)))
+    rate_hz = 1.0 / float(median(np.diff(t)))
     width = max(int(round(params.gate_smooth_s * rate_hz)), 1)
     speeds = {"wheel_surface_speed_mps": moving_average(ch["wheel_surface_speed_mps"], width),
               "sled_velocity_mps": moving_average(ch["sled_velocity_mps"], width)}

@@ -12,16 +12,17 @@ import numpy as np
 
 from stable_phase.registry import Cut, register
 from stable_phase.signals import moving_average
+from swtlab.order_stats import median
 
 
 def batch_means(t_s: np.ndarray, y: np.ndarray, period_s: float | None,
                 batch_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Period-long moving means sampled every ``batch_s``: (batch centre indices, means)."""
-    dt = float(np.median(np.diff(t_s)))
+    dt = float(median(np.diff(t_s)))
     width = max(int(round((period_s or batch_s) / dt)), 1)
     step = max(int(round(batch_s / dt)), 1)
     centres = np.arange(0, t_s.size, step)
-    return centres, moving_average(y, width, full_only=True)[centres]
+    return centres, moving_average(y, width, full_only=True, at=centres)
 
 
 def mser_two_sided(means: np.ndarray, max_cut_fraction: float,

@@ -123,10 +123,11 @@ class SettlingDetector:
     double_pole = False
 
     def locate(self, t_s, signals, period_s, params, gate_start) -> Cut:
-        dt = float(np.median(np.diff(t_s)))
+        dt = float(median(np.diff(t_s)))
         width = max(int(round((period_s or params.batch_s) / dt)), 1)
         step = -(-t_s.size // FIT_POINTS)
-        fits = {name: fit_settling(t_s[::step], moving_average(y, width, full_only=True)[::step],
+        kept = np.arange(0, t_s.size, step)
+        fits = {name: fit_settling(t_s[kept], moving_average(y, width, full_only=True, at=kept),
                                    self.double_pole)
                 for name, y in signals.items()}
         fits = {k: v for k, v in fits.items() if v is not None}

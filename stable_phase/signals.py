@@ -7,15 +7,16 @@ import numpy as np
 from swtlab.order_stats import median
 
 
-def moving_average(x, width: int, full_only: bool = False) -> np.ndarray:
+def moving_average(x, width: int, full_only: bool = False, at=None) -> np.ndarray:
     """Centred NaN-aware moving average over ``width`` samples (NaN where no sample is finite;
-    with ``full_only`` also NaN near the ends, where the window would be cut short)."""
+    with ``full_only`` also NaN near the ends, where the window would be cut short); at the
+    sample indices ``at`` only when given (the same values as the whole average's there)."""
     x = np.asarray(x, float)
     width = max(int(width), 1)
     ok = np.isfinite(x)
     pad = np.concatenate([[0.0], np.cumsum(np.where(ok, x, 0.0))])
     cnt = np.concatenate([[0], np.cumsum(ok)])
-    lo_raw = np.arange(x.size) - width // 2
+    lo_raw = (np.arange(x.size) if at is None else np.asarray(at, int)) - width // 2
     lo, hi = np.clip(lo_raw, 0, x.size), np.clip(lo_raw + width, 0, x.size)
     n = cnt[hi] - cnt[lo]
     if full_only:

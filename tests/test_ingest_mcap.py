@@ -260,3 +260,15 @@ def test_blocks_one_at_a_time_decode_as_the_checked_path_or_leave_it_to_it(block
         for name, values in checked.fields.items():
             np.testing.assert_array_equal(fast.fields[name], values)
             assert fast.fields[name].dtype == values.dtype == np.float64
+
+
+@pytest.mark.parametrize("block", [b'{"t_ns": [0, 10], "fz": [1.5, "2"]}',  # a string sample
+                                   b'{"t_ns": [0, 10], "fz": [true, 2]}',   # a boolean
+                                   b'{"t_ns": [0, 10], "fz": [1.5, 2], "unit": "N"}',
+                                   b'{"t_ns": [], "fz": {}}'])              # not a list
+def test_blocks_with_more_than_numbers_are_left_to_the_checks(block):
+    """Samples that ``array.array`` or ``np.array`` would turn into numbers (a boolean, a
+    numeric string) or an empty object where a list belongs: the one-pass decode declines."""
+    from ingest.mcap_reader import _plain_blocks
+
+    assert _plain_blocks([block]) is None
