@@ -93,7 +93,8 @@ RATE_PRESMOOTH_PX = 0.7
 #: spline support (prefilter pole 0.43 a pixel) reaches that static step is pulled towards zero
 #: motion. Measured on the second renderer (tuning seeds 900-905 and 910-915, 12 frames): the
 #: camera-frame error 0-3 px below the soil surface +1.7..+8.4 % of V (along e_theta), +0.8..
-#: +2.3 % with 2-3 px; alpha3 at the rearmost contact bin (beta -155 deg) -6.0 -> -3.4 % on average
+#: +2.3 % with 3 px (910-915); alpha3 at the rearmost contact bin (beta -155 deg) -6.0 -> -3.4 %
+#: on average (docs/softflow.md, fifth pass)
 EDGE_PX = 2
 
 
