@@ -88,6 +88,14 @@ BORDER_PX = 8
 #: first renderer's (noise 2 grey levels, no JPEG) pair error 0.0243 -> 0.0252 px (seeds 400,
 #: 401), so the displacement engine itself (pair_displacement_px) does not smooth by default
 RATE_PRESMOOTH_PX = 0.7
+#: the LK sums take only soil pixels at least this far (pixels of the pass) inside the soil mask,
+#: in frame a and where frame b is sampled: off the soil both frames are 0, and a pixel whose
+#: spline support (prefilter pole 0.43 a pixel) reaches that static step is pulled towards zero
+#: motion. Measured on the second renderer (tuning seeds 900-905 and 910-915, 12 frames): the
+#: camera-frame error 0-3 px below the soil surface +1.7..+8.4 % of V (along e_theta), +0.8..
+#: +2.3 % with 3 px (910-915); alpha3 at the rearmost contact bin (beta -155 deg) -6.0 -> -3.4 %
+#: on average (docs/softflow.md, fifth pass)
+EDGE_PX = 2
 
 
 @numba.njit(parallel=True, cache=True)
@@ -206,8 +214,23 @@ def _pass_products(a: np.ndarray, b_coefficients: np.ndarray, soil: np.ndarray, 
     p4 = np.empty((h // grid, w // grid, 4), np.float32)
     p1 = np.empty((h // grid, w // grid), np.float32)
     gx, gy = bspline_warp.gradient(both)
-    _cell_products(gx, gy, diff, soil, flow, grid, p4, p1)
+    _cell_products(gx, gy, diff, _clear_of_edges(soil, flow), flow, grid, p4, p1)
     return p4, p1, diff
+
+
+def _clear_of_edges(soil: np.ndarray, flow: np.ndarray) -> np.ndarray:
+    """``soil`` (float 0/1) less the pixels within ``EDGE_PX`` of its edge, in frame a or where
+    frame b is sampled (``x + flow``); the image border is not an edge here (``BORDER_PX``)."""
+    if soil.all():
+        return soil
+    size = 2 * EDGE_PX + 1
+    inner = cv2.erode((soil > 0).astype(np.uint8), np.ones((size, size), np.uint8),
+                      borderType=cv2.BORDER_REPLICATE)
+    h, w = soil.shape
+    y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    moved = cv2.remap(inner, x + flow[..., 0], y + flow[..., 1], cv2.INTER_NEAREST,
+                      borderMode=cv2.BORDER_REPLICATE)
+    return (inner & moved).astype(np.float32)
 
 
 def _window_means(p4: np.ndarray, p1: np.ndarray, size_px: int) -> tuple[np.ndarray, np.ndarray]:
