@@ -7,7 +7,10 @@ sec. 7.10, on paired per-run held-out losses):
    folds and quantities); the best candidate has the lowest mean;
 2. a candidate is *tied* with the best when its paired mean excess of ``log(1 + loss)``
    over the best is within ``Z_TIE`` standard errors, or below ``MIN_LOG_EXCESS`` (no
-   practical difference, however consistent);
+   practical difference, however consistent), or, for a single nested in the best
+   candidate (a pair), when the pair removes less than ``MIN_GAIN`` of the single's
+   held-out mean square ``1 + loss`` (:func:`gain_over_noise`: by rule 4b's measure the
+   second effect does not earn its place, so the pair is no practical improvement);
 3. the chosen one is the simplest tied candidate (fewest effects, then fewest parameters,
    then lowest loss);
 4. it is a confident call only if (a) no other tied candidate has as few effects but a
@@ -26,6 +29,13 @@ loss`` (:func:`gain_over_noise`): a second effect must explain a part of what is
 that matters against the run-to-run scatter, not a share of a misfit already far inside it
 (bench seed 21 c011 in family: 0.37 to 0.15 sigma RMS, 85 % of the loss, 10 % of the mean
 square, was a confident wrong "wheel_flexibility + bulldozing").
+
+Rule 2's nested tie (0.8.0) lets that single be chosen, and it is then judged by its own
+tests: the held-out bench's commonest miss was a law-shape patch of a few per cent (Ding's
+slip-sinkage under Lyasko's law, "slip_sinkage + wheel_flexibility" 5-7 % of the mean
+square ahead of slip_sinkage alone: inconclusive). A weak second effect of a true pair that
+hides inside the repeatability is then not named; the bench counts that as a wrong call
+(measured in docs/gap-report.md, "0.8.0").
 """
 
 from __future__ import annotations
@@ -105,7 +115,9 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
     effects or ``"inconclusive"``), ``chosen`` (label), ``leaders`` (labels to separate when
     inconclusive) and ``reason``."""
     best = losses[ranked[0]["label"]]
-    tied = [c for c in ranked if c["z_vs_best"] <= Z_TIE
+    patched = {label for label in _nested(ranked[0]["effects"])
+               if label in losses and gain_over_noise(losses[label], best) < MIN_GAIN}
+    tied = [c for c in ranked if c["z_vs_best"] <= Z_TIE or c["label"] in patched
             or np.mean(np.log1p(losses[c["label"]]) - np.log1p(best)) < MIN_LOG_EXCESS]
     chosen = min(tied, key=lambda c: (len(c["effects"]), c["n_params"], c["held_out_loss"]))
     rivals = [c for c in tied if len(c["effects"]) == len(chosen["effects"])
