@@ -7,10 +7,12 @@ sec. 7.10, on paired per-run held-out losses):
    folds and quantities); the best candidate has the lowest mean;
 2. a candidate is *tied* with the best when its paired mean excess of ``log(1 + loss)``
    over the best is within ``Z_TIE`` standard errors, or below ``MIN_LOG_EXCESS`` (no
-   practical difference, however consistent), or, for a single nested in the best
-   candidate (a pair), when the pair removes less than ``MIN_GAIN`` of the single's
-   held-out mean square ``1 + loss`` (:func:`gain_over_noise`: by rule 4b's measure the
-   second effect does not earn its place, so the pair is no practical improvement);
+   practical difference, however consistent), or, for the better of the two singles
+   nested in the best candidate (a pair), when the pair removes less than ``MIN_GAIN`` of
+   that single's held-out mean square ``1 + loss`` (:func:`gain_over_noise`: by rule 4b's
+   measure the second effect does not earn its place, so the pair is no practical
+   improvement on the effect it adds to; the worse single, which the pair's other effect
+   would have to carry, gets no such tie);
 3. the chosen one is the simplest tied candidate (fewest effects, then fewest parameters,
    then lowest loss);
 4. it is a confident call only if (a) no other tied candidate has as few effects but a
@@ -115,9 +117,10 @@ def decide(ranked: list[dict], losses: dict[str, np.ndarray]) -> dict:
     effects or ``"inconclusive"``), ``chosen`` (label), ``leaders`` (labels to separate when
     inconclusive) and ``reason``."""
     best = losses[ranked[0]["label"]]
-    patched = {label for label in _nested(ranked[0]["effects"])
-               if label in losses and gain_over_noise(losses[label], best) < MIN_GAIN}
-    tied = [c for c in ranked if c["z_vs_best"] <= Z_TIE or c["label"] in patched
+    nested = [label for label in _nested(ranked[0]["effects"]) if label in losses]
+    base = min(nested, key=lambda label: losses[label].mean(), default=None)
+    patched = base if base and gain_over_noise(losses[base], best) < MIN_GAIN else None
+    tied = [c for c in ranked if c["z_vs_best"] <= Z_TIE or c["label"] == patched
             or np.mean(np.log1p(losses[c["label"]]) - np.log1p(best)) < MIN_LOG_EXCESS]
     chosen = min(tied, key=lambda c: (len(c["effects"]), c["n_params"], c["held_out_loss"]))
     rivals = [c for c in tied if len(c["effects"]) == len(chosen["effects"])
