@@ -212,6 +212,22 @@ def test_a_pair_is_called_only_if_each_effect_earns_its_place():
     assert "improves on wheel_flexibility alone by only" in out["reason"]
 
 
+def test_the_nested_tie_is_for_the_better_single_only():
+    """Bench seed 27 c009 (second signal model, a Ding grouser truth under Bekker's law):
+    grousers + slip_sinkage 1.42, grousers alone 1.72 (11 % of its mean square), slip
+    sinkage alone 2.2 (24 %, but 0.5 behind grousers on every run). Grousers, which the pair
+    adds to, is tied with it; slip sinkage is no rival of grousers, and the call is
+    grousers."""
+    rng = np.random.default_rng(7)
+    base = 1.42 + rng.normal(0, 0.05, 60)
+    losses = {"soil_only": base + 1.06, "grousers": base + 0.30 + rng.normal(0, 0.02, 60),
+              "slip_sinkage": base + 0.78 + rng.normal(0, 0.02, 60),
+              "grousers+slip_sinkage": base}
+    assert gain_over_noise(losses["slip_sinkage"], base) < 0.25
+    out = decide(rank(_fake(losses), 60), losses)
+    assert out["chosen"] == "grousers" and out["verdict"] == ["grousers"]
+
+
 def test_a_second_effect_inside_the_repeatability_does_not_earn_its_place():
     """Bench seed 21 c011 in family: a flexible wheel (Wong's law) fitted to 0.37 sigma RMS
     held out, and a Rankine bulldozing of 0.1 x the formula that brought it to 0.15 sigma,
