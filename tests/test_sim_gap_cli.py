@@ -11,7 +11,8 @@ from sqlalchemy import select
 import terramechanics as tm
 import virtual_testbed as vt
 from swtlab_cli.cmd_gap import parse_laws
-from validation.gap_bench import (FAST_DESIGN, base_model, conditions, diagnosis_laws,
+from validation.gap_bench import (FAILURE_FILE, FAST_DESIGN, base_model, conditions,
+                                   diagnose_campaign, diagnosis_laws, format_score,
                                    laws_option, make_campaigns, run_bench, score, truth_law)
 from swtlab_cli.main import main
 from traceability import open_database
@@ -91,6 +92,35 @@ def test_gap_bench_is_blind_and_scored_from_labels(tmp_path):
     rows = {r["campaign"]: r for r in result["campaigns"]}
     assert [rows[n]["hidden"] for n in sorted(rows)] == [labels[n]["effects"]
                                                          for n in sorted(labels)]
+
+
+def test_a_campaign_whose_chain_fails_is_scored_as_failed_and_the_bench_goes_on(tmp_path):
+    """c001's database is missing (as when every run of a source was flagged, seed 30 c013):
+    its `swtlab gap` exits with a one-line error, which the bench keeps, removing the
+    earlier mode's report, and scores; c000 is scored from its report as before."""
+    tm.save_model(base_model(), tmp_path / "sim.toml")
+    labels = {"c000": {"effects": [], "laws": {}}, "c001": {"effects": ["grousers"],
+                                                           "laws": {"grousers": "bekker1956"}}}
+    (tmp_path / "labels").mkdir()
+    (tmp_path / "labels" / "labels.json").write_text(json.dumps(labels))
+    for name in labels:
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "laws.txt").write_text("\n")
+    (tmp_path / "c000" / "gap.json").write_text(json.dumps(
+        {"verdict": [], "decision": {}, "shrink_pct": {}}))
+    (tmp_path / "c001" / "gap.json").write_text("{}")  # an earlier mode's report
+    diagnose_campaign(tmp_path, "c001", boot=0, process=False)
+    assert not (tmp_path / "c001" / "gap.json").exists()
+    failure = (tmp_path / "c001" / FAILURE_FILE).read_text()
+    assert failure.startswith("gap --measured: ") and "swtlab.sqlite" in failure
+    assert len(failure.strip().splitlines()) == 1
+    s = score(tmp_path / "labels" / "labels.json", tmp_path)
+    assert s["by_class"]["none"]["exact"] == 1
+    assert s["by_class"]["single"] == {"n": 1, "exact": 0, "exact_share": 0.0,
+                                       "inconclusive": 0, "failed": 1, "confident_wrong": 0}
+    assert s["failed"] == [f"c001: {failure.strip()}"]
+    assert s["confusion"]["grousers"] == {"failed": 1}
+    assert "failed (scored as not exact): c001: gap --measured" in format_score(s)
 
 
 def test_gap_bench_modes_are_checked(tmp_path):

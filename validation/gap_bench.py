@@ -47,6 +47,8 @@ from swtlab.atomic import write_atomically
 from swtlab.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
 
 TRUTH_LAWS = ("in-family", "held-out")
+#: a campaign whose processing or diagnosis failed: the step and its one-line error
+FAILURE_FILE = "failure.txt"
 SIGNAL_MODELS = ("testbed", "second")
 #: hidden effect strengths, per law, drawn uniformly in these ranges; the ranges of the
 #: second law of each family give about the same RMS standardised change over the bench
@@ -227,8 +229,24 @@ def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True,
     """``swtlab process`` (unless ``process`` is False: the database is there; ``--jobs
     jobs`` when given) then ``swtlab gap`` in separate processes that are given the raw
     campaign folder, the database, the simulation and the laws they may use only. Returns
-    the seconds taken."""
+    the seconds taken. A step that fails does not stop the bench: its one-line error goes
+    to ``<campaign>/failure.txt`` (and an earlier mode's ``gap.json`` is removed), and the
+    campaign is scored as failed."""
     start = time.perf_counter()
+    folder = workdir / name
+    (folder / FAILURE_FILE).unlink(missing_ok=True)
+    try:
+        _process_and_diagnose(workdir, name, boot, process, jobs)
+    except subprocess.CalledProcessError as e:
+        (folder / "gap.json").unlink(missing_ok=True)
+        lines = (e.stderr or b"").decode(errors="replace").strip().splitlines()
+        write_atomically(folder / FAILURE_FILE,
+                         f"{' '.join(e.cmd[3:5])}: {lines[-1] if lines else 'no message'}\n")
+    return time.perf_counter() - start
+
+
+def _process_and_diagnose(workdir: Path, name: str, boot: int, process: bool,
+                          jobs: int | None) -> None:
     dbs = [(workdir / name / "campaign", f"sqlite:///{workdir / name / 'swtlab.sqlite'}")]
     if (workdir / name / "smooth" / "campaign").is_dir():
         dbs.append((workdir / name / "smooth" / "campaign",
@@ -244,7 +262,6 @@ def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True,
     subprocess.run(cli + ["gap", *measured, "--sim", str(workdir / "sim.toml"),
                           "--json", str(workdir / name / "gap.json"), "--boot", str(boot)]
                    + (["--laws", laws] if laws else []), check=True, capture_output=True)
-    return time.perf_counter() - start
 
 
 def _label(effects) -> str:
@@ -258,15 +275,24 @@ def score(labels_path: Path, workdir: Path) -> dict:
     labels = json.loads(Path(labels_path).read_text())
     rows = []
     for name, label in sorted(labels.items()):
+        hidden = label["effects"]
+        failure = workdir / name / FAILURE_FILE
+        if failure.exists():
+            rows.append({"campaign": name, "hidden": hidden, "hidden_laws": label["laws"],
+                         "allowed_laws": (workdir / name / "laws.txt").read_text().strip(),
+                         "law_dependent": False, "called": None, "failed":
+                         failure.read_text().strip(), "class": ("none", "single", "pair")[
+                             len(hidden)], "exact": False, "confident_wrong": False,
+                         "mean_shrink_pct": None})
+            continue
         report = json.loads((workdir / name / "gap.json").read_text())
         verdict = report["verdict"]
-        hidden = label["effects"]
         called = None if verdict == "inconclusive" else sorted(verdict, key=EFFECT_NAMES.index)
         shrink = report["shrink_pct"]
         rows.append({"campaign": name, "hidden": hidden, "hidden_laws": label["laws"],
                      "allowed_laws": (workdir / name / "laws.txt").read_text().strip(),
                      "law_dependent": bool(report["decision"].get("law_dependent")),
-                     "called": called,
+                     "called": called, "failed": None,
                      "class": ("none", "single", "pair")[len(hidden)],
                      "exact": called == hidden,
                      "confident_wrong": called is not None and called != hidden,
@@ -277,7 +303,9 @@ def score(labels_path: Path, workdir: Path) -> dict:
         out["by_class"][cls] = {"n": len(sub), "exact": sum(r["exact"] for r in sub),
                                 "exact_share": (sum(r["exact"] for r in sub) / len(sub))
                                 if sub else None,
-                                "inconclusive": sum(r["called"] is None for r in sub),
+                                "inconclusive": sum(r["called"] is None and not r["failed"]
+                                                    for r in sub),
+                                "failed": sum(bool(r["failed"]) for r in sub),
                                 "confident_wrong": sum(r["confident_wrong"] for r in sub)}
     for e in EFFECT_NAMES:
         tp = sum(r["called"] is not None and e in r["called"] and e in r["hidden"] for r in rows)
@@ -288,13 +316,16 @@ def score(labels_path: Path, workdir: Path) -> dict:
                                 "precision": tp / (tp + fp) if tp + fp else None,
                                 "recall": tp / (tp + fn) if tp + fn else None}
     for r in rows:
-        called = "inconclusive" if r["called"] is None else _label(r["called"])
+        called = ("failed" if r["failed"] else "inconclusive") if r["called"] is None \
+            else _label(r["called"])
         row = out["confusion"].setdefault(_label(r["hidden"]), {})
         row[called] = row.get(called, 0) + 1
     effect_rows = [r for r in rows if r["called"] and r["mean_shrink_pct"] is not None]
     out.update({
         "exact_share": sum(r["exact"] for r in rows) / max(len(rows), 1),
-        "inconclusive_share": sum(r["called"] is None for r in rows) / max(len(rows), 1),
+        "inconclusive_share": sum(r["called"] is None and not r["failed"] for r in rows)
+        / max(len(rows), 1),
+        "failed": [f"{r['campaign']}: {r['failed']}" for r in rows if r["failed"]],
         "confident_wrong_share": sum(r["confident_wrong"] for r in rows) / max(len(rows), 1),
         "law_dependent": sum(r["law_dependent"] for r in rows),
         "mean_shrink_pct": float(np.mean([r["mean_shrink_pct"] for r in effect_rows]))
@@ -308,11 +339,13 @@ def format_score(s: dict) -> str:
     for cls, v in s["by_class"].items():
         share = "n/a" if v["exact_share"] is None else f"{100 * v['exact_share']:.0f} %"
         lines.append(f"  {cls:6s} n={v['n']:3d} exact {share:>6s}  inconclusive "
-                     f"{v['inconclusive']}  confident-wrong {v['confident_wrong']}")
+                     f"{v['inconclusive']}  confident-wrong {v['confident_wrong']}  "
+                     f"failed {v['failed']}")
     lines.append(f"exact-set accuracy {100 * s['exact_share']:.0f} %, inconclusive "
                  f"{100 * s['inconclusive_share']:.0f} %, confident wrong "
                  f"{100 * s['confident_wrong_share']:.0f} %; inconclusive because the call "
                  f"depended on a law: {s['law_dependent']}")
+    lines += [f"failed (scored as not exact): {f}" for f in s["failed"]]
     shrink = s["mean_shrink_pct"]
     lines.append("mean shrink (confident effect calls): "
                  + ("n/a" if shrink is None else f"{shrink:.1f} %"))
