@@ -366,8 +366,9 @@ def common_share(samples_per_period: float, periods: float) -> float:
     window's mean error is ``mean_p (frac(delta - p phi) - 1/2)`` over its ``N`` whole periods;
     its variance over ``delta`` (averaged on a fine grid) in units of ``1/12`` is the share:
     1 where the sensor sees the same phases every period (``phi = 0``), ``1/N^2`` where its
-    grid slips evenly through a spacing over the window (``phi = j/N``). The rest of the sampling error differs from period to period and
-    is in the residual's whole-pitch batch means (the statistical term) already."""
+    grid slips evenly through a spacing over the window (``phi = j/N``). The rest of the
+    sampling error differs from period to period and is in the residual's whole-pitch batch
+    means (the statistical term) already."""
     delta = (np.arange(JUMP_PLACES) + 0.5) / JUMP_PLACES
     shift = (float(samples_per_period) % 1.0) * np.arange(max(int(periods), 1))
     error = (np.mod(delta[:, None] - shift[None, :], 1.0) - 0.5).mean(axis=1)
