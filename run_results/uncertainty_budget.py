@@ -48,7 +48,8 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   IEEE Trans. Instrum. Meas. 45(2) 353); load cells and the suspension arm.
 - ``phase_sampling``: a sensor sampling a sharp-edged grouser wave only ``m`` times a period
   sees few of its phases; the rectangle rule over a period errs by at most ``drop / (2 m)``
-  for a jump ``drop`` (the largest step between adjacent phase bins of the waveform), a
+  for a jump ``drop`` (the largest step of the waveform between adjacent phase bins or across
+  one, where a jump inside a bin splits), a
   bound taken as rectangular (GUM 4.3.7), times the root of the share of that error which
   is the same in every period of the window (:func:`common_share`): where the sensor's
   phases slip from period to period the error changes from period to period too, and the
@@ -378,7 +379,9 @@ def common_share(samples_per_period: float, periods: float) -> float:
 def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -> Term | None:
     """Bound ``drop / (2 m)`` on the window mean of a periodic wave sampled ``m`` times a
     period, scaled by the root of :func:`common_share` (the part the same in every period),
-    as a rectangular term (module doc); None without a frequency or samples."""
+    as a rectangular term (module doc); None without a frequency or samples. ``drop``: the
+    largest step of the phase-averaged waveform between adjacent bins or across one bin (a
+    jump that falls inside a bin is split between its two steps)."""
     if not frequency_hz or y.size < 2:
         return None
     average = phase_average(t_s, y, frequency_hz)
@@ -387,7 +390,9 @@ def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -
     wave = average["waveform"][np.isfinite(average["waveform"])]
     if wave.size < 2:
         return None
-    drop = float(np.max(np.abs(np.diff(np.append(wave, wave[0])))))
+    # a jump inside a bin splits between that bin's two steps: the step across it counts too
+    ring = np.concatenate([wave[-1:], wave, wave[:1]])
+    drop = float(max(np.max(np.abs(np.diff(ring))), np.max(np.abs(ring[2:] - ring[:-2]))))
     per_period = 1.0 / (frequency_hz * float(median(np.diff(t_s))))
     share = common_share(per_period, frequency_hz * float(t_s[-1] - t_s[0]))
     return Term(drop / (2.0 * per_period) / math.sqrt(3.0) * math.sqrt(share), rectangular=True)

@@ -230,6 +230,19 @@ def test_the_sampling_error_common_to_every_period_against_sampled_sawtooths():
     assert slipping.u == pytest.approx(0.95 / 81 / math.sqrt(3) * 0.5, rel=0.02)
 
 
+def test_phase_sampling_reads_a_jump_inside_a_bin_across_that_bin():
+    """A sawtooth whose jump (1) falls in the middle of a 20-bin waveform's bin 10, sampled
+    40 times a period at the same phases: that bin holds one sample from either side, so
+    each of its two steps reads about half the jump (0.45 with the ramp), the step across it
+    0.9 (by hand: bins 9 and 11 average 0.94 and 0.04); the term is 0.9/(2m)/sqrt(3)."""
+    from run_results.uncertainty_budget import phase_sampling
+
+    m, f = 40, 0.5
+    t = (np.arange(1600) + 0.25) / (m * f)
+    term = phase_sampling(t, np.mod(f * t - 0.525, 1.0), f)
+    assert term.u == pytest.approx(0.9 / (2 * m) / math.sqrt(3), rel=0.02)
+
+
 def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
     """A flat channel (found by the fuzzer): sigma 1e-14 of a, the quantile is a(2p - 1)."""
     from run_results.uncertainty_budget import rect_normal_quantile
