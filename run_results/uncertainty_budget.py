@@ -48,13 +48,8 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   IEEE Trans. Instrum. Meas. 45(2) 353); load cells and the suspension arm.
 - ``phase_sampling``: a sensor sampling a sharp-edged grouser wave only ``m`` times a period
   sees few of its phases; the rectangle rule over a period errs by at most ``drop / (2 m)``
-  for a jump ``drop`` (the largest step of the waveform between adjacent phase bins or across
-  one, where a jump inside a bin splits), a
-  bound taken as rectangular (GUM 4.3.7), times the root of the share of that error which
-  is the same in every period of the window (:func:`common_share`): where the sensor's
-  phases slip from period to period the error changes from period to period too, and the
-  residual about the phase-averaged wave carries that part into the statistical term's batch
-  means (counted there once). Load cells and the suspension arm, with grousers.
+  for a jump ``drop`` (the largest step between adjacent phase bins of the waveform), a
+  bound taken as rectangular (GUM 4.3.7). Load cells and the suspension arm, with grousers.
 - ``clock``: the loggers' rate error, rectangular within ``+-clock_rate_bound_ppm`` (the
   logger's stated clock tolerance), relative on speeds, ``(1 - |s|) sqrt(2) u`` on slip (the
   wheel and sled encoders' clocks apart).
@@ -355,33 +350,9 @@ def _quantisation(q: float, spread: float) -> float:
     return q / math.sqrt(12) * math.exp(-2 * math.pi**2 * (spread / q) ** 2)
 
 
-#: places of the jump, relative to the sample grid, averaged over in :func:`common_share`
-JUMP_PLACES = 2048
-
-
-def common_share(samples_per_period: float, periods: float) -> float:
-    """The share of a sampled jump's rectangle-rule error variance that is the same in every
-    period of the window. Over one period the samples sit ``delta`` (of a sample spacing) past
-    the jump, an error ``drop (delta - 1/2) / m``, variance ``1/12`` of ``(drop/m)^2`` over
-    the jump's unknown place (uniform). Each period moves the grid by ``phi = frac(m)``, so the
-    window's mean error is ``mean_p (frac(delta - p phi) - 1/2)`` over its ``N`` whole periods;
-    its variance over ``delta`` (averaged on a fine grid) in units of ``1/12`` is the share:
-    1 where the sensor sees the same phases every period (``phi = 0``), ``1/N^2`` where its
-    grid slips evenly through a spacing over the window (``phi = j/N``). The rest of the
-    sampling error differs from period to period and is in the residual's whole-pitch batch
-    means (the statistical term) already."""
-    delta = (np.arange(JUMP_PLACES) + 0.5) / JUMP_PLACES
-    shift = (float(samples_per_period) % 1.0) * np.arange(max(int(periods), 1))
-    error = (np.mod(delta[:, None] - shift[None, :], 1.0) - 0.5).mean(axis=1)
-    return float(min(12.0 * np.mean(error**2), 1.0))
-
-
 def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -> Term | None:
     """Bound ``drop / (2 m)`` on the window mean of a periodic wave sampled ``m`` times a
-    period, scaled by the root of :func:`common_share` (the part the same in every period),
-    as a rectangular term (module doc); None without a frequency or samples. ``drop``: the
-    largest step of the phase-averaged waveform between adjacent bins or across one bin (a
-    jump that falls inside a bin is split between its two steps)."""
+    period (module doc), as a rectangular term; None without a frequency or samples."""
     if not frequency_hz or y.size < 2:
         return None
     average = phase_average(t_s, y, frequency_hz)
@@ -390,12 +361,9 @@ def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -
     wave = average["waveform"][np.isfinite(average["waveform"])]
     if wave.size < 2:
         return None
-    # a jump inside a bin splits between that bin's two steps: the step across it counts too
-    ring = np.concatenate([wave[-1:], wave, wave[:1]])
-    drop = float(max(np.max(np.abs(np.diff(ring))), np.max(np.abs(ring[2:] - ring[:-2]))))
+    drop = float(np.max(np.abs(np.diff(np.append(wave, wave[0])))))
     per_period = 1.0 / (frequency_hz * float(median(np.diff(t_s))))
-    share = common_share(per_period, frequency_hz * float(t_s[-1] - t_s[0]))
-    return Term(drop / (2.0 * per_period) / math.sqrt(3.0) * math.sqrt(share), rectangular=True)
+    return Term(drop / (2.0 * per_period) / math.sqrt(3.0), rectangular=True)
 
 
 def _statistical(s: QuantityStats) -> Term:

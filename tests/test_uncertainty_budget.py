@@ -190,8 +190,7 @@ def test_an_unstated_clock_is_said_to_be_assumed():
 def test_phase_sampling_bounds_the_mean_of_a_sharp_wave_seen_m_times_a_period():
     """A sawtooth (rise 0 -> 1, drop 1) sampled m = 40 times a period: the sample mean errs
     by up to 1/(2m) (by hand: mean of frac(phi + k/m) = (m-1)/(2m) + phi'); the term is
-    drop/(2m)/sqrt(3) with the drop read from the phase-averaged waveform (20 bins: 0.95),
-    all of it common to every period (the same phases each period)."""
+    drop/(2m)/sqrt(3) with the drop read from the phase-averaged waveform (20 bins: 0.95)."""
     from run_results.uncertainty_budget import phase_sampling
 
     m, f = 40, 0.5
@@ -201,46 +200,6 @@ def test_phase_sampling_bounds_the_mean_of_a_sharp_wave_seen_m_times_a_period():
     term = phase_sampling(t, np.mod(f * t + 0.3, 1.0), f)
     assert term.rectangular and term.u == pytest.approx(0.95 / (2 * m) / math.sqrt(3), rel=0.02)
     assert phase_sampling(t, np.mod(f * t, 1.0), None) is None
-
-
-def test_the_sampling_error_common_to_every_period_against_sampled_sawtooths():
-    """A sawtooth (drop 1) sampled m times a period over N whole periods, its jump at an
-    unknown place: the sample mean's error variance over the jump's place (4,000 places,
-    independent of the budget's code) is ``common_share`` of the one-period ``1/(12 m^2)``.
-    By hand: 1 at m = 40 (the same phases every period), 1/4 at m = 40.5 (two interleaved
-    grids: the error uniform on +-1/(4m)), 1/N^2 at m = 40 + 1/N (the grid slips evenly, a
-    comb N times finer); simulated at m = 40.37, 40.1, 40.93. The phase-sampling term scales
-    by its root (the drop read from the 20-bin waveform, 0.95, at both m)."""
-    from run_results.uncertainty_budget import common_share, phase_sampling
-
-    f, places = 0.5, (np.arange(4000) + 0.5) / 4000
-    for m, periods, by_hand in ((40.0, 10, 1.0), (40.5, 10, 0.25), (40.2, 5, 1 / 25),
-                                (40.37, 10, None), (40.1, 8, None), (40.93, 6, None)):
-        t = np.arange(0.0, periods / f - 1e-9, 1 / (m * f))
-        errors = [np.mod(f * t + psi, 1.0).mean() - 0.5 for psi in places]
-        simulated = np.var(errors) * 12 * m * m
-        share = common_share(m, periods)
-        assert share == pytest.approx(simulated, rel=0.06, abs=1e-4)
-        if by_hand is not None:
-            assert share == pytest.approx(by_hand, rel=1e-4)
-    t40, t405 = (np.arange(0.0, 20.0, 1 / (m * f)) for m in (40.0, 40.5))
-    same = phase_sampling(t40, np.mod(f * t40 + 0.3, 1.0), f)
-    slipping = phase_sampling(t405, np.mod(f * t405 + 0.3, 1.0), f)
-    assert same.u == pytest.approx(0.95 / 80 / math.sqrt(3), rel=0.02)
-    assert slipping.u == pytest.approx(0.95 / 81 / math.sqrt(3) * 0.5, rel=0.02)
-
-
-def test_phase_sampling_reads_a_jump_inside_a_bin_across_that_bin():
-    """A sawtooth whose jump (1) falls in the middle of a 20-bin waveform's bin 10, sampled
-    40 times a period at the same phases: that bin holds one sample from either side, so
-    each of its two steps reads about half the jump (0.45 with the ramp), the step across it
-    0.9 (by hand: bins 9 and 11 average 0.94 and 0.04); the term is 0.9/(2m)/sqrt(3)."""
-    from run_results.uncertainty_budget import phase_sampling
-
-    m, f = 40, 0.5
-    t = (np.arange(1600) + 0.25) / (m * f)
-    term = phase_sampling(t, np.mod(f * t - 0.525, 1.0), f)
-    assert term.u == pytest.approx(0.9 / (2 * m) / math.sqrt(3), rel=0.02)
 
 
 def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
