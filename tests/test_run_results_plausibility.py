@@ -155,6 +155,24 @@ def test_a_dig_in_with_a_flat_tail_is_flagged(tmp_path):
     assert plain.flags == () and result.status == "flagged"
 
 
+def test_an_overshoot_settling_from_the_start_is_no_dig_in(tmp_path):
+    """The run settling to its slip-sinkage (gap bench seed 30 c013): the DP is 60 N above
+    its level when the speeds are up (gate at 3.9 s) and decays as exp(-(t - 5)/4 s) into
+    the window. It collapses by more than the dig-in check's share, but it never rose after
+    the gate: no flag, and the window's DP is the plain run's (4 s constant: 0.05 N left at
+    the window's start)."""
+    overshoot = lambda t, y: y + 60.0 * np.exp(-np.clip(t - 5.0, 0.0, None) / 4.0) \
+        * (t > 3.0)  # noqa: E731
+    _, plain = _process(tmp_path)
+    _, settling = _process(tmp_path, lambda c: _map_field(c, "/tether/force", ("dp",),
+                                                          overshoot))
+    assert settling.window.diagnostics["gate_start_s"] < 5.0
+    assert settling.window.found and not _flags(settling, "dig-in")
+    assert settling.status == "ok"
+    assert settling.quantities["dp_n"].mean == pytest.approx(plain.quantities["dp_n"].mean,
+                                                              abs=0.5)
+
+
 def test_sinkage_growing_through_the_first_window_is_a_dig_in(tmp_path):
     """The hub sinks 4 mm more, at a steady 0.2 mm/s from 20 to 40 s, then holds: the window
     kept is the flat second half, and the growth through the first candidate window (at most
