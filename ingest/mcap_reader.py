@@ -1,8 +1,9 @@
 """MCAP form reader (spec: "MCAP form"): JSON blocks of samples, metadata records, camera frames.
 
-One ``orjson.loads`` per block, each field made an array at once (``_plain_blocks``); only a
-block that may hold more than numbers goes through the sample-by-sample checks
-(``_checked_blocks``), which name the first problem.
+A topic whose blocks are objects of short numbers is parsed straight into arrays
+(``_number_blocks``, ``ingest.json_blocks``); else one ``orjson.loads`` per block, each field
+made an array at once (``_plain_blocks``); only a block that may hold more than numbers goes
+through the sample-by-sample checks (``_checked_blocks``), which name the first problem.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import orjson
 from mcap.reader import NonSeekingReader, make_reader
 
 from ingest.errors import IngestError
+from ingest.json_blocks import FIELD_COLUMNS, parse_blocks
 from ingest.raw import FrameIndex, RawRun, RawTopic
 
 IMAGE_SCHEMA = "foxglove.CompressedImage"
@@ -79,9 +81,56 @@ def _loads(message: bytes):
 
 def _decode_blocks(path: Path, topic: str, data: list[bytes]) -> RawTopic:
     """Concatenate a topic's blocks (ordered by their first time stamp) into field arrays:
-    :func:`_plain_blocks` when it can, else every sample checked (:func:`_checked_blocks`)."""
-    plain = _plain_blocks(data)
-    return plain if plain is not None else _checked_blocks(path, topic, data)
+    :func:`_number_blocks` or :func:`_plain_blocks` when they can, else every sample checked
+    (:func:`_checked_blocks`)."""
+    for decode in (_number_blocks, _plain_blocks):
+        topic_arrays = decode(data)
+        if topic_arrays is not None:
+            return topic_arrays
+    return _checked_blocks(path, topic, data)
+
+
+def _number_blocks(data: list[bytes]) -> RawTopic | None:
+    """:func:`_plain_blocks` without Python numbers: every block parsed by
+    :func:`ingest.json_blocks.parse_blocks`; None where it declines or where
+    :func:`_plain_blocks` would (a block without ``t_ns``, a key twice, other keys than the
+    first block's, fields of different lengths, stamps not whole or out of range)."""
+    if not data:
+        return None
+    sizes = np.fromiter(map(len, data), np.int64, len(data))
+    stops = np.cumsum(sizes)
+    starts = stops - sizes
+    buf = b"".join(data)
+    codes = np.frombuffer(buf, np.uint8)
+    values, ints = np.empty(len(buf) // 2 + 1), np.empty(len(buf) // 2 + 1, np.int64)
+    fields = np.empty((len(buf) // 5 + len(data), FIELD_COLUMNS), np.int64)
+    rows = parse_blocks(codes, starts, stops, values, ints, fields)
+    if rows < 0:
+        return None
+    names: list[str] | None = None
+    spans: list[dict[str, tuple[int, int]]] = []
+    for block, key, key_stop, first, stop, whole in fields[:rows].tolist():
+        if block == len(spans):
+            spans.append({})
+        name = buf[key:key_stop].decode("ascii")
+        if name in spans[-1] or (name == "t_ns" and not whole):
+            return None
+        spans[-1][name] = (first, stop)
+    for block in spans:
+        if names is None:
+            names = list(block)
+        sizes = {stop - first for first, stop in block.values()}
+        if "t_ns" not in block or block.keys() != set(names) or len(sizes) != 1:
+            return None
+    firsts = [ints[b["t_ns"][0]] if b["t_ns"][1] > b["t_ns"][0] else np.iinfo(np.int64).max
+              for b in spans]  # an empty block sorts last
+    order = np.argsort(firsts, kind="stable")
+    t_ns = np.concatenate([ints[slice(*spans[i]["t_ns"])] for i in order])
+    if t_ns.size and not (0 <= t_ns.min() and t_ns.max() <= MAX_T_NS):
+        return None
+    return RawTopic(t_s=t_ns * 1e-9, fields={
+        name: np.concatenate([values[slice(*spans[i][name])] for i in order])
+        for name in names if name != "t_ns"})
 
 
 def _plain_blocks(data: list[bytes]) -> RawTopic | None:

@@ -272,3 +272,105 @@ def test_blocks_with_more_than_numbers_are_left_to_the_checks(block):
     from ingest.mcap_reader import _plain_blocks
 
     assert _plain_blocks([block]) is None
+
+
+def _parsed(text: str):
+    """``ingest.json_blocks.parse_blocks`` of one block ``{"x": [text]}``: (value, int or
+    None), or None where it declines."""
+    from ingest.json_blocks import FIELD_COLUMNS, parse_blocks
+
+    block = f'{{"x": [{text}]}}'.encode()
+    values, ints = np.empty(4), np.empty(4, np.int64)
+    fields = np.empty((4, FIELD_COLUMNS), np.int64)
+    rows = parse_blocks(np.frombuffer(block, np.uint8), np.array([0]), np.array([len(block)]),
+                        values, ints, fields)
+    if rows < 0:
+        return None
+    assert rows == 1 and fields[0, 4] - fields[0, 3] == 1
+    return values[0], (int(ints[0]) if fields[0, 5] else None)
+
+
+def test_short_numbers_parse_to_the_correctly_rounded_double():
+    """Against CPython's ``float()`` (David Gay's correctly rounded reader, no shared code):
+    random decimals of 1-15 significant digits, exponents -30..30 spelt with a point, an
+    exponent or both, bit for bit; integers also as themselves."""
+    rng = np.random.default_rng(2026)
+    parsed = 0
+    for _ in range(20000):
+        digits = "".join(rng.choice(list("0123456789"), int(rng.integers(1, 16))))
+        point = int(rng.integers(0, len(digits) + 1))
+        mantissa = digits[:point] or "0"
+        if point < len(digits):
+            mantissa = f"{int(mantissa)}.{digits[point:]}"
+        else:
+            mantissa = str(int(mantissa))
+        exponent = int(rng.integers(-30, 31))
+        text = ("-" if rng.random() < 0.3 else "") + mantissa + (
+            f"e{exponent}" if rng.random() < 0.5 else "")
+        got = _parsed(text)
+        if got is None:
+            continue
+        parsed += 1
+        truth = float(text) if ("." in text or "e" in text) else float(int(text))
+        assert np.float64(got[0]).tobytes() == np.float64(truth).tobytes(), text
+        if got[1] is not None:
+            assert "." not in text and "e" not in text and got[1] == int(text)
+    assert parsed > 15000  # the fast path covers most short numbers
+
+
+@pytest.mark.parametrize("text, value", [("-0", 0.0), ("-0.0", -0.0), ("0e7", 0.0),
+                                         ("-0e-3", -0.0), ("null", np.nan), ("1E2", 100.0),
+                                         ("123456789012345678", 123456789012345678.0),
+                                         ("0.000000000000000000001", 1e-21)])
+def test_signed_zeros_null_and_long_integers_as_orjson_and_array_give_them(text, value):
+    """What the one-pass decode makes of them: ``array('d', orjson.loads(...))``."""
+    import array
+
+    import orjson
+
+    got = _parsed(text)
+    truth = np.frombuffer(array.array("d", [np.nan if v is None else v
+                                             for v in orjson.loads(f"[{text}]")]))[0]
+    assert np.float64(got[0]).tobytes() == np.float64(truth).tobytes() == \
+        np.float64(value).tobytes()
+
+
+@pytest.mark.parametrize("text", ["01", "1.", ".5", "+1", "-", "1e", "1e+", "nul", "-null",
+                                  "NaN", "Infinity", "true", '"1"', "[1]", "{}",
+                                  "0.30000000000000004",  # 17 digits: past 2^53
+                                  "1e23", "1.5e-400", "1234567890123456789"])
+def test_numbers_outside_the_fast_path_or_json_are_declined(text):
+    assert _parsed(text) is None
+
+
+@pytest.mark.parametrize("blocks", [
+    [b'{"t_ns": [5, 9], "fz": [1, -2.5e-3]}', b'{"t_ns": [], "fz": []}',
+     b'{ "fz" : [ null ] , "t_ns" : [ 0 ] }\n'],           # keys in another order, spaces
+    [b'{"t_ns": [20], "fz": [2]}', b'{"t_ns": [0, 10], "fz": [1.5, null]}'],  # out of order
+    [b'{"t_ns": [0, 1], "true_fz": [-0, -0.0]}']])       # "true" in a key: checked path
+def test_number_blocks_give_the_checked_arrays(blocks):
+    from ingest.mcap_reader import _checked_blocks, _number_blocks
+
+    fast, checked = _number_blocks(blocks), _checked_blocks(Path("run.mcap"), "/t", blocks)
+    assert fast is not None
+    assert fast.t_s.tobytes() == checked.t_s.tobytes()
+    assert list(fast.fields) == list(checked.fields)
+    for name, values in checked.fields.items():
+        assert fast.fields[name].dtype == np.float64
+        assert fast.fields[name].tobytes() == values.tobytes()
+
+
+@pytest.mark.parametrize("blocks", [
+    [b'{"t_ns": [0, 10], "fz": [0.30000000000000004, 2]}'],  # orjson's (_plain_blocks) then
+    [b'{"t_ns": [0, 1e3], "fz": [1.5, 2]}'],                 # stamps not whole
+    [b'{"t_ns": [0, 10], "fz": [1.5]}'],                     # lengths differ
+    [b'{"t_ns": [0], "fz": [1], "fz": [2]}'],                # a key twice
+    [b'{"t_ns": [0], "fz": [1]}', b'{"t_ns": [1], "fy": [1]}'],  # other keys
+    [b'{"fz": [1]}'], [b'{}'], [b'[1]'], [b'{"t_ns": [0]} x'], [b'{"t_ns": [0]'],
+    [b'{"t_\\u006es": [0], "fz": [1]}'], ['{"t_ns": [0], "f\u00e9": [1]}'.encode()],
+    [b'{"t_ns": [-5], "fz": [1]}'], [b'{"t_ns": [0], "fz": [[1]]}'],
+    [b'{"t_ns": [0], "fz": [1], "unit": "N"}']])
+def test_number_blocks_decline_what_the_other_paths_decode_or_name(blocks):
+    from ingest.mcap_reader import _number_blocks
+
+    assert _number_blocks(blocks) is None
