@@ -40,8 +40,21 @@ FIT_POINTS = 5000
 DOUBLE_STARTS = ((0.0, 1.0), (-1.0, 1.0), (-1.0, 2.0), (-2.0, 2.0))
 
 
-def _exponential(t, a, b, tau, t0):
-    return a + b * np.exp(-np.clip(t - t0, 0.0, None) / tau)
+class _Exponential:
+    """``a + b exp(-max(t - t_on, 0)/tau)``, keeping the decay of the last ``(t, tau, t_on)``:
+    curve_fit's finite-difference steps in ``a`` and ``b`` reuse it (the same numbers as
+    computing it again, without two of every four exponentials of its Jacobian)."""
+
+    def __init__(self):
+        self._key: tuple | None = None
+        self._decay: np.ndarray | None = None
+
+    def __call__(self, t, a, b, tau, t0):
+        key = self._key
+        if key is None or key[0] is not t or key[1] != tau or key[2] != t0:
+            self._decay = np.exp(-np.maximum(t - t0, 0.0) / tau)
+            self._key = (t, tau, t0)
+        return a + b * self._decay
 
 
 def _repeated_pole(t, a, b, c, tau, t0):
@@ -74,7 +87,7 @@ def fit_settling(t_s: np.ndarray, y: np.ndarray, double_pole: bool = True) -> di
     t, y = t_s[ok] - t_s[0], y[ok]
     span = float(t[-1])
     a0 = median(y[t >= 0.75 * span])
-    plain = _fit(_exponential, t, y, (a0, float(y[0] - a0), span / 10.0, 0.0),
+    plain = _fit(_Exponential(), t, y, (a0, float(y[0] - a0), span / 10.0, 0.0),
                  [-np.inf, -np.inf, 1e-3 * span, 0.0], [np.inf, np.inf, 2.0 * span, 0.5 * span])
     if plain is None:
         return None

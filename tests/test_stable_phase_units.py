@@ -148,3 +148,21 @@ def test_set_points_and_grouser_period():
     assert surface_speed_setpoint_mps(0.01, -0.5) == pytest.approx(0.005)
     assert grouser_period_s(12, 2 * np.pi / 12) == pytest.approx(1.0)
     assert grouser_period_s(0, 1.0) is None
+
+
+def test_settling_model_keeps_its_decay_only_for_the_same_time_constant_and_onset():
+    """The fit's model with its decay kept: bit for bit the formula evaluated afresh, along a
+    finite-difference-like sequence of parameter vectors (steps in a, b, tau, t_on)."""
+    from stable_phase.settling import _Exponential
+
+    t = np.linspace(0.0, 30.0, 3001)
+    model = _Exponential()
+    base = np.array([2.0, -1.5, 4.0, 1.25])
+    for step in ([0, 0, 0, 0], [1e-8, 0, 0, 0], [0, 1e-8, 0, 0], [0, 0, 1e-8, 0],
+                 [0, 0, 0, 1e-8], [0.1, 0.2, 0.3, 0.4], [0.1, 0.3, 0.3, 0.4]):
+        a, b, tau, t0 = base + np.array(step)
+        truth = a + b * np.exp(-np.clip(t - t0, 0.0, None) / tau)
+        assert model(t, a, b, tau, t0).tobytes() == truth.tobytes()
+    other = t[::2].copy()  # another time base: never the kept decay
+    truth = a + b * np.exp(-np.clip(other - t0, 0.0, None) / tau)
+    assert model(other, a, b, tau, t0).tobytes() == truth.tobytes()
