@@ -6,7 +6,9 @@ reused. Timed: ``ingest.read_run`` per run (decode, validate, calibrate, common
 time base, derived signals), one process, warm file cache. The decode limit: every message
 of the same files read with the ``mcap`` reader (CRCs checked, as ingest does), each JSON
 block parsed by ``orjson`` and each of its fields made one numpy array; nothing checked,
-sorted, calibrated or derived. Wall and CPU seconds, the fastest of :data:`REPEATS`
+sorted, calibrated or derived. It is the limit of reading through orjson's Python objects;
+ingest parses blocks of short numbers without them (``ingest.json_blocks``), so it can go
+below 1x. Wall and CPU seconds, the fastest of :data:`REPEATS`
 interleaved passes of each (CPU: on a shared machine, where wall time includes waiting).
 Issue 19 item 4: ingest within 1.3x the limit.
 """
