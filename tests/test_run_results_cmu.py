@@ -63,7 +63,11 @@ def test_window_means_agree_with_the_authors(results, authors):
         d_slip = q["slip"].mean - row["slip"]
         d_hub = q["hub_height_m"].mean * 1e3 - row["hub_z_mm"]
         assert abs(d_speed) < (TOL_WHEEL_SPEED_LOCKED_MM_S if locked else TOL_WHEEL_SPEED_MM_S)
-        assert abs(d_slip) < (TOL_SLIP_LOCKED if locked else TOL_SLIP), run_id
+        # slip at a few mm/s is noisy: our window's mean has an SE up to 0.005 (gr810
+        # 12-7-20/10_10_0_1, slip 0: 0.0053 +- 0.0052 over 60.8-81.1 s, the authors' 70-75 s
+        # gives 0.0001), so a window a few seconds apart moves it by about its SE
+        tol = (TOL_SLIP_LOCKED if locked else TOL_SLIP) + 3 * q["slip"].se
+        assert abs(d_slip) < tol, run_id
         assert abs(d_hub) < TOL_HUB_Z_MM, run_id
         rows.append((d_speed, d_slip, d_hub))
     d = np.abs(np.array(rows))
