@@ -276,9 +276,10 @@ def second_renderer(wheels: int) -> dict:
 #: seeds of the decay-rate figures; tuning seeds (not reported): second renderer 400-405 (polar
 #: stage, sled velocity, the flow's border rejection: 400 and 401; the jackknife CIs), 600-605,
 #: 700-705 and 900-905 (the figures of earlier passes, looked at since), 910-915 (with 900-905:
-#: the flow engine's edge band ``EDGE_PX`` and the fit start); 930-945 were used only to compare
-#: 0.7.0 with the edge band on the smooth wheel (docs/softflow.md, fifth pass)
-DECAY_SEEDS = tuple(range(920, 926))
+#: the flow engine's edge band ``EDGE_PX`` and the fit start; the joint fit over neighbouring
+#: angles, ``softflow.field_analysis.RATE_BINS``); 920-945 were the fifth pass's figures (looked
+#: at since); 970-975 the sixth pass's (docs/softflow.md)
+DECAY_SEEDS = tuple(range(970, 976))
 #: frames per run: the flow's error is spatially correlated over about 16 px and differs from
 #: pair to pair, so it averages out over pairs (tuning seed 400: 5 pairs left alpha3 6.6 % low
 #: on average, 11 pairs 0.4 %); ``swtlab process`` takes up to 32 frames of the stable phase

@@ -20,7 +20,7 @@ import cv2
 import numpy as np
 
 from softflow.alpha12 import fit_alpha12, rates_and_sigmas
-from softflow.decay_fit import DecayFit, fit_decay
+from softflow.decay_fit import DecayFit, fit_decay_across
 from softflow.flow_checks import (alpha12_reason, check_contact_fits, check_sled_velocity,
                                   eps_reason, fit_reason)
 from softflow.flow_engine import EDGE_PX, MeanField, average_flow
@@ -41,6 +41,36 @@ BIN_WIDTH_DEG = 10.0
 SLED_REFINEMENTS = 12  # at most; the offset shrinks about twofold each time
 #: fewest frame pairs for the jackknife CI of the rates; with fewer the fit's own CI is kept
 MIN_JACKKNIFE_PAIRS = 3
+#: the rate of a beta bin is fitted together with its nearest neighbours that have profiles
+#: (within ``RATE_BIN_REACH`` bins; :func:`fit_profiles`), this many bins in all: 3, the bin and
+#: its two neighbours, or at the end of the contact region the next two inwards. The flow's pair
+#: noise is correlated over about 16 px (a 10 deg bin is 15-35 px wide there), so it differs
+#: partly from bin to bin while the rate varies slowly with the angle (second renderer, smooth
+#: wheel, tuning seeds 900-915: k / alpha3 within 5 % in 110 / 133 of 120 / 148 defined contact
+#: bins with each bin alone, 116 / 140 with 3 bins; 5 bins, rate linear: 116 / 141, but the rate's
+#: curvature over 40 deg biases it, alpha3 mean -1.1 -> -1.8 %; 5 bins, quadratic: 113 / 136)
+RATE_BINS = 3
+RATE_BIN_REACH = 2
+
+
+def fit_profiles(prof: list, rim_px: float, px_per_m: float, bins=None) -> list:
+    """Decay fit of each beta bin's profile (:func:`softflow.decay_fit.fit_decay_across` with its
+    ``RATE_BINS - 1`` nearest neighbours that have 5 or more points, within ``RATE_BIN_REACH``
+    bins, the nearer first and, at equal distance, both); ``bins``: only these, the others None.
+    """
+    n = len(prof)
+    rho = [(p[0] - rim_px) / px_per_m for p in prof]
+    width = np.deg2rad(BIN_WIDTH_DEG)
+    out = [None] * n
+    for j in range(n) if bins is None else bins:
+        steps = [d for k in range(1, RATE_BIN_REACH + 1) for d in (-k, k)]
+        near = [0] + [d for d in steps if len(rho[(j + d) % n]) >= 5][:RATE_BINS - 1]
+        near.sort()
+        idx = [(j + d) % n for d in near]
+        out[j] = fit_decay_across([rho[m] for m in idx], [prof[m][1] for m in idx],
+                                  [prof[m][2] for m in idx], np.array(near, float) * width,
+                                  near.index(0))
+    return out
 
 
 @dataclass
@@ -246,8 +276,7 @@ def world_profiles(v_cam: np.ndarray, sled: np.ndarray, r_px: np.ndarray, beta: 
     def fitted(sled):
         v_r, v_t = resolve(v_cam + sled, theta, direction)
         prof = [profiles(v, r_px, beta, centres, width, r_min_px) for v in (v_r, v_t)]
-        return (*prof, *([fit_decay((p[0] - rim_px) / px_per_m, p[1], p[2]) for p in pr]
-                         for pr in prof))
+        return (*prof, *(fit_profiles(pr, rim_px, px_per_m) for pr in prof))
 
     prof_r, prof_t, radial, tangential = fitted(sled)
     for _ in range(SLED_REFINEMENTS):
@@ -295,9 +324,11 @@ def jackknife_ci(radial: list, tangential: list, mean: MeanField, sled: np.ndarr
         for c, (v, fits) in enumerate(zip(resolve(loo / px_per_m + sled, theta, direction),
                                           (radial, tangential))):
             prof = profiles(v, r_px, beta, centres, width, r_min_px)
-            for j in np.flatnonzero([f is not None for f in fits]):
-                f = fit_decay((prof[j][0] - rim_px) / px_per_m, prof[j][1], prof[j][2])
-                rates[i, c, j] = f.rate_per_m if f else np.nan
+            refits = fit_profiles(prof, rim_px, px_per_m,
+                                  np.flatnonzero([f is not None for f in fits]))
+            for j, f in enumerate(refits):
+                if f is not None:
+                    rates[i, c, j] = f.rate_per_m
     t = stats.t.ppf(0.975, n_pairs - 1)
     out = []
     for c, fits in enumerate((radial, tangential)):

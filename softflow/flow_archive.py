@@ -51,8 +51,10 @@ def _fit(d: dict | None) -> DecayFit | None:
     if d is None:
         return None
     ci = tuple(np.nan if v is None else v for v in d["ci95_per_m"])
+    # results stored before the joint fits over neighbouring angles: each bin alone
     return DecayFit(d["amplitude_mps"], d["rate_per_m"], ci,
-                    np.nan if d["r2"] is None else d["r2"], d["points"], d.get("ci95_dof"))
+                    np.nan if d["r2"] is None else d["r2"], d["points"], d.get("ci95_dof"),
+                    tuple(d.get("joint_bins_offset_deg", (0.0,))))
 
 
 def _profiles(z, c: str, step: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:

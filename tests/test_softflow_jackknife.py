@@ -6,8 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from softflow.decay_fit import fit_decay
-from softflow.field_analysis import jackknife_ci
+from softflow.field_analysis import fit_profiles, jackknife_ci
 from softflow.flow_engine import MeanField
 from softflow.polar import beta_bins, polar_coordinates, profiles
 
@@ -45,9 +44,8 @@ def test_jackknife_ci_holds_the_rates():
         world = mean / PX_PER_M + SLED
         comp = (world[..., 0] * np.sin(theta) + world[..., 1] * np.cos(theta) if c == 0
                 else world[..., 0] * np.cos(theta) - world[..., 1] * np.sin(theta))
-        fits.append([fit_decay((p[0] - RIM_PX) / PX_PER_M, p[1], p[2]) if len(p[0]) >= 5
-                     else None for p in profiles(comp, r_px, beta, centres, np.deg2rad(10),
-                                                 r_min)])
+        fits.append(fit_profiles(profiles(comp, r_px, beta, centres, np.deg2rad(10), r_min),
+                                 RIM_PX, PX_PER_M))
     radial, tangential = jackknife_ci(fits[0], fits[1], field, SLED, r_px, beta, theta,
                                       centres, RIM_PX, r_min, PX_PER_M, 1)
     cover_jk, cover_fit = [], []
