@@ -145,14 +145,33 @@ def test_sample_contents_and_size():
 
 @pytest.mark.parametrize("run_id", ["L180_MP0_SC_s+020", "L300_MP0_SC_s+090", "L070_MP0_TW",
                                     "L180_MP0_FS", "L180_MP0_SC_s+035"])
-def test_regenerates_bit_for_bit(tmp_path, run_id):
+def test_regenerates_raw_bit_for_bit_and_truth_to_rounding(tmp_path, run_id):
     index, (condition, form) = next((i, cf) for i, cf in enumerate(sample_conditions())
                                     if cf[0].run_id == run_id)
     raw, truth = make_run(condition, SEED, started_at(SEED, index), SAMPLE_TESTBED, form)
     path = write_run(raw, truth, tmp_path)
     assert _sha256_tree(path) == _sha256_tree(SAMPLE / truth["raw_file"])
-    assert (tmp_path / "truth" / f"{run_id}.json").read_bytes() == \
-        (SAMPLE / "truth" / f"{run_id}.json").read_bytes()
+    # the truth's steady values come from the model's trigonometry and root finding, whose
+    # last bits depend on NumPy's SIMD path (AVX2 and AVX-512 differ by ~1e-14 relative):
+    # the same keys, texts and integers, floats to 1e-9
+    _same_to_rounding(json.loads((tmp_path / "truth" / f"{run_id}.json").read_text()),
+                      json.loads((SAMPLE / "truth" / f"{run_id}.json").read_text()))
+
+
+def _same_to_rounding(a, b, where="truth"):
+    assert type(a) is type(b), where
+    if isinstance(a, dict):
+        assert list(a) == list(b), where
+        for k in a:
+            _same_to_rounding(a[k], b[k], f"{where}/{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b)):
+            _same_to_rounding(x, y, f"{where}[{i}]")
+    elif isinstance(a, float):
+        assert a == pytest.approx(b, rel=1e-9, abs=1e-12), where
+    else:
+        assert a == b, where
 
 
 @pytest.mark.parametrize("run_id", [r for r, t in TRUTHS.items() if t["form"] == "mcap"])
