@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import curve_fit
 
+MAX_EXPONENT = 700.0  # exp(700) ~ 1e304, below float64's overflow
+
 
 @dataclass
 class DecayFit:
@@ -91,7 +93,10 @@ def fit_decay_across(rho_m: list, value: list, sigma: list, offsets_rad: np.ndar
     dbeta = np.asarray(offsets_rad, float)[which]
 
     def resid(p):
-        return (p[2:][which] * np.exp(-(p[0] + p[1] * dbeta) * rho) - val) / sig
+        # a trial step far below zero rate would overflow exp: capped, it is a worse step
+        # that Levenberg-Marquardt rejects as it would an infinite one
+        exponent = np.minimum(-(p[0] + p[1] * dbeta) * rho, MAX_EXPONENT)
+        return (p[2:][which] * np.exp(exponent) - val) / sig
 
     start = [v[np.argmin(r)] for r, v in zip(rho_m, value)]
     start[centre] = own.amplitude
