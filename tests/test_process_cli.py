@@ -126,6 +126,42 @@ def test_killed_batch_finishes_on_rerun_without_duplicates(tmp_path):
     assert len(set(paths)) == len(paths) == len(run_ids)
 
 
+@pytest.mark.skipif(sys.platform != "linux", reason="the workers' end rests on Linux's prctl")
+def test_workers_end_with_a_killed_batch(tmp_path):
+    """SIGKILL a ``--jobs 2`` batch once its workers run: both workers are gone within 10 s
+    (before, they waited on their task queue for ever)."""
+    psutil = pytest.importorskip("psutil")
+    run_ids = sorted(p.stem for p in (SAMPLE / "campaign").glob("L300_*.mcap"))
+    campaign = _small_campaign(tmp_path, run_ids)
+    command = [sys.executable, "-m", "swtlab_cli.main", "process", str(campaign), "--db",
+               f"sqlite:///{tmp_path / 'swtlab.sqlite'}", "--jobs", "2", "--quiet"]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    batch = psutil.Process(process.pid)
+    deadline = time.monotonic() + 120
+    workers = []
+    while time.monotonic() < deadline and process.poll() is None and len(workers) < 2:
+        time.sleep(0.05)
+        workers = batch.children()
+    assert len(workers) == 2, "the batch ended before its two workers ran"
+    time.sleep(1.0)  # past the workers' start (their initializer)
+    process.send_signal(signal.SIGKILL)
+    process.wait(timeout=60)
+
+    def running(worker) -> bool:
+        try:
+            return worker.status() != psutil.STATUS_ZOMBIE
+        except psutil.NoSuchProcess:
+            return False
+
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(running(w) for w in workers):
+        time.sleep(0.1)
+    left = [w.pid for w in workers if running(w)]
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    assert not left, f"workers {left} outlived their killed batch"
+
+
 def test_campaign_rig_compliance_is_applied_and_stored(tmp_path):
     """A campaign's [rig_compliance] lifts the hub by m_per_n * (fz - ref): sinkage drops by it."""
     run_id = "L300_MP0_SC_s+020"

@@ -6,6 +6,9 @@ one writer (docs/scale-out.md)."""
 from __future__ import annotations
 
 import dataclasses
+import os
+import signal
+import sys
 import tomllib
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
@@ -15,6 +18,8 @@ from pathlib import Path
 
 from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
 
+#: prctl(2) option: the signal a process gets when its parent dies (linux/prctl.h)
+PR_SET_PDEATHSIG = 1
 #: the campaign's settings file (``[rig_compliance]``, ``[uncertainty]``, docs/run-results.md)
 CAMPAIGN_SETTINGS = "swtlab.toml"
 
@@ -146,12 +151,30 @@ def worker_pool(workers: int) -> Iterator[ProcessPoolExecutor]:
     runs, for the workers forked from this process to inherit (see
     ``softflow.threads.opencv_threads``)."""
     from softflow.threads import opencv_threads
-    from swtlab.cores import limit_threads, threads_per_worker
+    from swtlab.cores import threads_per_worker
 
     threads = threads_per_worker(workers)
     with opencv_threads(threads), ProcessPoolExecutor(
-            workers, initializer=limit_threads, initargs=(threads,)) as pool:
+            workers, initializer=_start_worker, initargs=(threads, os.getpid())) as pool:
         yield pool
+
+
+def _start_worker(threads: int, parent_pid: int) -> None:
+    """A worker's start: its share of the threads (``swtlab.cores.limit_threads``), and its
+    end with the batch's process. A batch killed by SIGKILL runs no clean-up, and its forked
+    workers, holding both ends of their task queue's pipe, would wait on it for ever; on
+    Linux the kernel sends them SIGTERM when their parent dies (``prctl(PR_SET_PDEATHSIG)``,
+    prctl(2)), and a worker whose parent died before the request ends at once."""
+    from swtlab.cores import limit_threads
+
+    limit_threads(threads)
+    if sys.platform != "linux":
+        return
+    import ctypes
+
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+    if os.getppid() != parent_pid:
+        os._exit(1)
 
 
 def _process(path: Path, settings: ProcessSettings, content: tuple[str, int] | None,
