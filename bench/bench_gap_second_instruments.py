@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 import terramechanics as tm
-from validation.gap_bench import FAST_DESIGN, base_model, conditions, diagnose_campaign, draw_truth
+from validation.gap_bench import (FAST_DESIGN, ModeFiles, base_model, conditions,
+                                  diagnose_campaign, draw_truth)
 from validation.gap_bench_second import rig_conditions
 from validation.model_truth import ModelTruth
 from validation.second_rig import Rig, SensorModel, Timeline, write_campaign
@@ -58,13 +59,13 @@ def main(quick: bool = False) -> dict:
                                rig_conditions(conditions(FAST_DESIGN), name, BB2_WHEEL),
                                ModelTruth(truths[i][0]), SEED * 1000 + i, rig=rig)
                 shutil.rmtree(work / name / "truth")
-                (work / name / "laws.txt").write_text("\n")  # in family: every law
+                ModeFiles.of(work / name, "in-family").laws.write_text("\n")  # every law
                 names.append(name)
         with ThreadPoolExecutor(2) as pool:
             list(pool.map(lambda n: diagnose_campaign(work, n, 50), names))
         out = {}
         for name in names:
-            report = json.loads((work / name / "gap.json").read_text())
+            report = json.loads(ModeFiles.of(work / name, "in-family").gap.read_text())
             hidden = truths[int(name[1:4])][1]["effects"]
             out[name] = {"hidden": hidden, "called": report["verdict"],
                          "exact": report["verdict"] == hidden, "reason": report["reason"]}

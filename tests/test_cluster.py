@@ -115,7 +115,7 @@ def test_a_gap_bench_campaign_on_the_cluster_is_the_local_one(client, tmp_path):
     there = run_bench(1, workdir=tmp_path / "there", client=client, **runs)
     files = _files(tmp_path / "here")
     assert len([f for f in files if f.endswith(".mcap")]) == 8
-    assert b"sqlite:///WORK/c000/swtlab.sqlite" in files["c000/gap.json"]
+    assert b"sqlite:///WORK/c000/swtlab.sqlite" in files["c000/gap-held-out.json"]
     assert _files(tmp_path / "there") == files
     assert there["timing_s"]["jobs"] == 2 and here["n"] == 1
     assert ({k: v for k, v in there.items() if k != "timing_s"}

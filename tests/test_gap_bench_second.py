@@ -32,8 +32,8 @@ def test_second_rig_bench_is_blind_and_scored(tmp_path):
     seen = {p.relative_to(tmp_path / "c000").as_posix()
             for p in (tmp_path / "c000").rglob("*") if p.is_file()}
     assert seen == ({f"campaign/r{i:03d}.mcap" for i in range(8)}
-                    | {"laws.txt", "swtlab.sqlite", "gap.json"})
-    assert (tmp_path / "c000" / "laws.txt").read_text().strip() == laws_option(
+                    | {"laws-held-out.txt", "swtlab.sqlite", "gap-held-out.json"})
+    assert (tmp_path / "c000" / "laws-held-out.txt").read_text().strip() == laws_option(
         diagnosis_laws(0, "held-out"))
     truth_files = sorted((tmp_path / "labels" / "c000" / "truth").glob("*.json"))
     assert [p.stem for p in truth_files] == [f"r{i:03d}" for i in range(8)]
@@ -56,10 +56,10 @@ def test_second_rig_bench_is_blind_and_scored(tmp_path):
     assert cells == set(itertools.product(TINY.loads_n, TINY.slips, TINY.multipass,
                                           TINY.gravity_mps2))
     # every run went through `swtlab process` into the diagnosis
-    report = json.loads((tmp_path / "c000" / "gap.json").read_text())
+    report = json.loads((tmp_path / "c000" / "gap-held-out.json").read_text())
     assert report["n_points"] == 8
     # scoring: gap_bench's score of the labels against the written report
-    assert result == {**score(tmp_path / "labels" / "labels.json", tmp_path),
+    assert result == {**score(tmp_path / "labels" / "labels.json", tmp_path, "held-out"),
                       "truth_laws": "held-out", "timing_s": result["timing_s"]}
     row = result["campaigns"][0]
     assert row["hidden"] == label["effects"]

@@ -27,7 +27,8 @@ def test_smooth_wheel_runs_on_the_same_hidden_soil_and_is_diagnosed_with_the_lug
             for p in (tmp_path / "c000").rglob("*") if p.is_file()}
     runs = {f"r{i:03d}.mcap" for i in range(8)}
     assert seen == ({f"campaign/{r}" for r in runs} | {f"smooth/campaign/{r}" for r in runs}
-                    | {"laws.txt", "swtlab.sqlite", "smooth.sqlite", "gap.json"})
+                    | {"laws-held-out.txt", "swtlab.sqlite", "smooth.sqlite",
+                       "gap-held-out.json"})
     # each smooth run's steady values: the hidden model's curves without the grousers
     for path in sorted((tmp_path / "labels" / "c000" / "smooth" / "truth").glob("*.json")):
         doc = json.loads(path.read_text())
@@ -36,7 +37,7 @@ def test_smooth_wheel_runs_on_the_same_hidden_soil_and_is_diagnosed_with_the_lug
         expected = model.with_wheel(grouser_count=0, grouser_height_m=0.0).curves(
             c["load_n"], c["slip_setpoint"], c["multipass"], c["gravity_mps2"])
         assert np.isclose(doc["law_steady"]["dp_n"], float(expected["dp_n"]), rtol=1e-9)
-    report = json.loads((tmp_path / "c000" / "gap.json").read_text())
+    report = json.loads((tmp_path / "c000" / "gap-held-out.json").read_text())
     assert report["n_points"] == 16
     wheels = {s["wheel"]["name"]: s["wheel"]["grouser_count"] for s in report["sources"]}
     assert wheels == {BB2_WHEEL.name: BB2_WHEEL.grouser_count, smooth_wheel().name: 0}

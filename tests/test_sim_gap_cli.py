@@ -11,7 +11,7 @@ from sqlalchemy import select
 import terramechanics as tm
 import virtual_testbed as vt
 from swtlab_cli.cmd_gap import parse_laws
-from validation.gap_bench import (FAILURE_FILE, FAST_DESIGN, base_model, conditions,
+from validation.gap_bench import (FAST_DESIGN, ModeFiles, base_model, conditions,
                                    diagnose_campaign, diagnosis_laws, format_score,
                                    laws_option, make_campaigns, run_bench, score, truth_law)
 from swtlab_cli.main import main
@@ -78,7 +78,7 @@ def test_gap_bench_is_blind_and_scored_from_labels(tmp_path):
     for i, name in enumerate(labels):  # the diagnosis saw no truth: it lives outside
         assert not (tmp_path / name / "truth").exists()
         assert (tmp_path / "labels" / name / "truth").is_dir()
-        report = json.loads((tmp_path / name / "gap.json").read_text())
+        report = json.loads((tmp_path / name / "gap-held-out.json").read_text())
         allowed = report["settings"]["laws"]  # every family lost the truth's law
         assert sorted(allowed) == sorted(tm.LAWS)
         for effect, options in allowed.items():
@@ -87,7 +87,7 @@ def test_gap_bench_is_blind_and_scored_from_labels(tmp_path):
             assert law == truth_law(i, effect) and law not in allowed[effect]
             assert labels[name]["truth_laws"] == "held-out"
     assert result["n"] == 3 and sum(v["n"] for v in result["by_class"].values()) == 3
-    assert result == {**score(tmp_path / "labels" / "labels.json", tmp_path),
+    assert result == {**score(tmp_path / "labels" / "labels.json", tmp_path, "held-out"),
                       "truth_laws": "held-out", "timing_s": result["timing_s"]}
     rows = {r["campaign"]: r for r in result["campaigns"]}
     assert [rows[n]["hidden"] for n in sorted(rows)] == [labels[n]["effects"]
@@ -97,21 +97,24 @@ def test_gap_bench_is_blind_and_scored_from_labels(tmp_path):
 def test_a_campaign_whose_chain_fails_is_scored_as_failed_and_the_bench_goes_on(tmp_path):
     """c001's database is missing (as when every run of a source was flagged, seed 30 c013):
     its `swtlab gap` exits with a one-line error, which the bench keeps, removing the
-    earlier mode's report, and scores; c000 is scored from its report as before."""
+    mode's earlier report (the other mode's stays), and scores; c000 is scored from its
+    report as before."""
     tm.save_model(base_model(), tmp_path / "sim.toml")
     labels = {"c000": {"effects": [], "laws": {}}, "c001": {"effects": ["grousers"],
                                                            "laws": {"grousers": "bekker1956"}}}
     (tmp_path / "labels").mkdir()
     (tmp_path / "labels" / "labels.json").write_text(json.dumps(labels))
+    files = {name: ModeFiles.of(tmp_path / name, "in-family") for name in labels}
     for name in labels:
         (tmp_path / name).mkdir()
-        (tmp_path / name / "laws.txt").write_text("\n")
-    (tmp_path / "c000" / "gap.json").write_text(json.dumps(
-        {"verdict": [], "decision": {}, "shrink_pct": {}}))
-    (tmp_path / "c001" / "gap.json").write_text("{}")  # an earlier mode's report
+        files[name].laws.write_text("\n")
+    files["c000"].gap.write_text(json.dumps({"verdict": [], "decision": {}, "shrink_pct": {}}))
+    files["c001"].gap.write_text("{}")  # this mode's earlier report
+    other = ModeFiles.of(tmp_path / "c001", "held-out").gap
+    other.write_text("{}")  # the other mode's report
     diagnose_campaign(tmp_path, "c001", boot=0, process=False)
-    assert not (tmp_path / "c001" / "gap.json").exists()
-    failure = (tmp_path / "c001" / FAILURE_FILE).read_text()
+    assert not files["c001"].gap.exists() and other.read_text() == "{}"
+    failure = files["c001"].failure.read_text()
     assert failure.startswith("gap --measured: ") and "swtlab.sqlite" in failure
     assert len(failure.strip().splitlines()) == 1
     s = score(tmp_path / "labels" / "labels.json", tmp_path)

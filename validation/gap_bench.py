@@ -5,11 +5,14 @@ Layout of the work folder::
 
     sim.toml                      the simulation given to every diagnosis (base model)
     c000/campaign/...             raw runs of campaign 0 (all a diagnosis can read)
-    c000/laws.txt                 the laws the diagnosis may use (``swtlab gap --laws``)
+    c000/laws-held-out.txt        the laws the diagnosis may use (``swtlab gap --laws``),
+                                  one file per mode (``in-family``, ``held-out``)
     c000/swtlab.sqlite            `swtlab process` output
     c000/smooth/campaign/...      with ``Design.smooth_wheel``: the same conditions run by a
     c000/smooth.sqlite            smooth wheel of the same size on the same soil
-    c000/gap.json                 `swtlab gap` report
+    c000/gap-held-out.json        `swtlab gap` report of that mode (a failed step:
+    c000/failure-held-out.txt     its one-line error instead); diagnosing under the other
+                                  mode writes its own files and keeps these
     labels/labels.json            hidden effect sets, laws and strengths (only the scorer)
     labels/c000/truth/...         the signal model's per-run truth, moved out of the campaign
 
@@ -47,9 +50,23 @@ from swtlab.atomic import write_atomically
 from swtlab.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
 
 TRUTH_LAWS = ("in-family", "held-out")
-#: a campaign whose processing or diagnosis failed: the step and its one-line error
-FAILURE_FILE = "failure.txt"
 SIGNAL_MODELS = ("testbed", "second")
+
+
+@dataclass(frozen=True)
+class ModeFiles:
+    """A campaign's files of one diagnosis mode (``truth_laws``): the laws it may use, its
+    report, and, where the processing or the diagnosis failed, the step and its one-line
+    error. Each mode has its own, so diagnosing again under the other loses nothing."""
+
+    laws: Path
+    gap: Path
+    failure: Path
+
+    @classmethod
+    def of(cls, folder: Path, truth_laws: str) -> ModeFiles:
+        return cls(folder / f"laws-{truth_laws}.txt", folder / f"gap-{truth_laws}.json",
+                   folder / f"failure-{truth_laws}.txt")
 #: hidden effect strengths, per law, drawn uniformly in these ranges; the ranges of the
 #: second law of each family give about the same RMS standardised change over the bench
 #: design as the first law's (0.8-2 sigma for multipass up to 5-14 for slip-sinkage), but
@@ -215,7 +232,7 @@ def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
         with ProcessPoolExecutor(workers) as pool:
             list(pool.map(_generate, jobs))
     for i in range(n):
-        write_atomically(workdir / f"c{i:03d}" / "laws.txt",
+        write_atomically(ModeFiles.of(workdir / f"c{i:03d}", truth_laws).laws,
                          laws_option(diagnosis_laws(i, truth_laws)) + "\n")
     labels = {f"c{i:03d}": {**label, "truth_laws": truth_laws, "signal_model": signal_model}
               for i, (_, label) in enumerate(truths)}
@@ -225,28 +242,29 @@ def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
 
 
 def diagnose_campaign(workdir: Path, name: str, boot: int, process: bool = True,
-                      jobs: int | None = None) -> float:
+                      jobs: int | None = None, truth_laws: str = "in-family") -> float:
     """``swtlab process`` (unless ``process`` is False: the database is there; ``--jobs
     jobs`` when given) then ``swtlab gap`` in separate processes that are given the raw
-    campaign folder, the database, the simulation and the laws they may use only. Returns
-    the seconds taken. A step that fails does not stop the bench: its one-line error goes
-    to ``<campaign>/failure.txt`` (and an earlier mode's ``gap.json`` is removed), and the
-    campaign is scored as failed."""
+    campaign folder, the database, the simulation and the laws they may use only (the
+    ``truth_laws`` mode's :class:`ModeFiles`). Returns the seconds taken. A step that
+    fails does not stop the bench: its one-line error goes to the mode's failure file
+    (and the mode's report of an earlier diagnosis is removed), and the campaign is
+    scored as failed."""
     start = time.perf_counter()
-    folder = workdir / name
-    (folder / FAILURE_FILE).unlink(missing_ok=True)
+    files = ModeFiles.of(workdir / name, truth_laws)
+    files.failure.unlink(missing_ok=True)
     try:
-        _process_and_diagnose(workdir, name, boot, process, jobs)
+        _process_and_diagnose(workdir, name, boot, process, jobs, files)
     except subprocess.CalledProcessError as e:
-        (folder / "gap.json").unlink(missing_ok=True)
+        files.gap.unlink(missing_ok=True)
         lines = (e.stderr or b"").decode(errors="replace").strip().splitlines()
-        write_atomically(folder / FAILURE_FILE,
+        write_atomically(files.failure,
                          f"{' '.join(e.cmd[3:5])}: {lines[-1] if lines else 'no message'}\n")
     return time.perf_counter() - start
 
 
 def _process_and_diagnose(workdir: Path, name: str, boot: int, process: bool,
-                          jobs: int | None) -> None:
+                          jobs: int | None, files: ModeFiles) -> None:
     dbs = [(workdir / name / "campaign", f"sqlite:///{workdir / name / 'swtlab.sqlite'}")]
     if (workdir / name / "smooth" / "campaign").is_dir():
         dbs.append((workdir / name / "smooth" / "campaign",
@@ -257,10 +275,10 @@ def _process_and_diagnose(workdir: Path, name: str, boot: int, process: bool,
             subprocess.run(cli + ["process", str(folder), "--db", db, "--quiet"]
                            + (["--jobs", str(jobs)] if jobs else []), check=True,
                            capture_output=True)
-    laws = (workdir / name / "laws.txt").read_text().strip()
+    laws = files.laws.read_text().strip()
     measured = [arg for _, db in dbs for arg in ("--measured", db)]
     subprocess.run(cli + ["gap", *measured, "--sim", str(workdir / "sim.toml"),
-                          "--json", str(workdir / name / "gap.json"), "--boot", str(boot)]
+                          "--json", str(files.gap), "--boot", str(boot)]
                    + (["--laws", laws] if laws else []), check=True, capture_output=True)
 
 
@@ -270,27 +288,28 @@ def _label(effects) -> str:
     return "+".join(effects) if effects else "none"
 
 
-def score(labels_path: Path, workdir: Path) -> dict:
-    """Compare each campaign's verdict with its hidden label (the only reader of labels)."""
+def score(labels_path: Path, workdir: Path, truth_laws: str = "in-family") -> dict:
+    """Compare each campaign's verdict under the ``truth_laws`` mode with its hidden label
+    (the only reader of labels)."""
     labels = json.loads(Path(labels_path).read_text())
     rows = []
     for name, label in sorted(labels.items()):
         hidden = label["effects"]
-        failure = workdir / name / FAILURE_FILE
-        if failure.exists():
+        files = ModeFiles.of(workdir / name, truth_laws)
+        if files.failure.exists():
             rows.append({"campaign": name, "hidden": hidden, "hidden_laws": label["laws"],
-                         "allowed_laws": (workdir / name / "laws.txt").read_text().strip(),
+                         "allowed_laws": files.laws.read_text().strip(),
                          "law_dependent": False, "called": None, "failed":
-                         failure.read_text().strip(), "class": ("none", "single", "pair")[
+                         files.failure.read_text().strip(), "class": ("none", "single", "pair")[
                              len(hidden)], "exact": False, "confident_wrong": False,
                          "mean_shrink_pct": None})
             continue
-        report = json.loads((workdir / name / "gap.json").read_text())
+        report = json.loads(files.gap.read_text())
         verdict = report["verdict"]
         called = None if verdict == "inconclusive" else sorted(verdict, key=EFFECT_NAMES.index)
         shrink = report["shrink_pct"]
         rows.append({"campaign": name, "hidden": hidden, "hidden_laws": label["laws"],
-                     "allowed_laws": (workdir / name / "laws.txt").read_text().strip(),
+                     "allowed_laws": files.laws.read_text().strip(),
                      "law_dependent": bool(report["decision"].get("law_dependent")),
                      "called": called, "failed": None,
                      "class": ("none", "single", "pair")[len(hidden)],
@@ -381,7 +400,7 @@ def rediagnose(workdir: Path, truth_laws: str, jobs: int = 2, boot: int = 50,
     labels = workdir / "labels" / "labels.json"
     n = len(json.loads(labels.read_text()))
     for i in range(n):
-        write_atomically(workdir / f"c{i:03d}" / "laws.txt",
+        write_atomically(ModeFiles.of(workdir / f"c{i:03d}", truth_laws).laws,
                          laws_option(diagnosis_laws(i, truth_laws)) + "\n")
     return _diagnose_and_score(labels, workdir, n, jobs, boot, False, truth_laws, 0.0, client)
 
@@ -396,13 +415,13 @@ def _diagnose_and_score(labels: Path, workdir: Path, n: int, jobs: int, boot: in
 
         jobs = sum(task_slots(client).values())
         seconds = list(map_in_order(client, diagnose_campaign, [workdir] * n, names,
-                                    [boot] * n, [process] * n, [1] * n))
+                                    [boot] * n, [process] * n, [1] * n, [truth_laws] * n))
     else:
         with ThreadPoolExecutor(jobs) as pool:
-            seconds = list(pool.map(lambda name: diagnose_campaign(workdir, name, boot,
-                                                                   process), names))
+            seconds = list(pool.map(lambda name: diagnose_campaign(
+                workdir, name, boot, process, truth_laws=truth_laws), names))
     t2 = time.perf_counter()
-    out = {**score(labels, workdir), "truth_laws": truth_laws}
+    out = {**score(labels, workdir, truth_laws), "truth_laws": truth_laws}
     out["timing_s"] = {"generate": generate_s, "process_and_diagnose": t2 - t1,
                        "per_campaign_mean": float(np.mean(seconds)), "jobs": jobs}
     write_atomically(workdir / f"score-{truth_laws}.json", json.dumps(out, indent=1) + "\n")
