@@ -76,7 +76,6 @@ from run_results.phase_average import phase_average, phase_bins
 from run_results.rest_readings import RestReadings, resolution
 from run_results.stats import PitchBatches, QuantityStats
 from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
-from swtlab.order_stats import median
 
 #: quantity -> (load-cell column, divide by the wheel radius?) for the single-cell quantities
 CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),
