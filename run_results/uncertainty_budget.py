@@ -47,12 +47,9 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   first harmonic of the quantiser's mean error for Gaussian input, Widrow, Kollar & Liu 1996,
   IEEE Trans. Instrum. Meas. 45(2) 353); load cells and the suspension arm.
 - ``phase_sampling``: a sensor sampling a sharp-edged grouser wave only ``m`` times a period
-  sees few of its phases; the mean of the phase-bin means of a wave with a jump ``D`` errs
-  by ``D`` times that of a unit sawtooth at the samples' phases, whose variance over the
-  jump's unknown place (uniform, GUM 4.3.7) follows from the phases themselves
-  (:func:`sawtooth_variance`: ``1/(12 m^2)`` where the grid repeats each period, far less
-  where it slips), ``D`` at its bound, the waveform's peak-to-peak (:func:`phase_sampling`).
-  Load cells and the suspension arm, with grousers.
+  sees few of its phases; the rectangle rule over a period errs by at most ``drop / (2 m)``
+  for a jump ``drop`` (the largest step between adjacent phase bins of the waveform), a
+  bound taken as rectangular (GUM 4.3.7). Load cells and the suspension arm, with grousers.
 - ``clock``: the loggers' rate error, rectangular within ``+-clock_rate_bound_ppm`` (the
   logger's stated clock tolerance), relative on speeds, ``(1 - |s|) sqrt(2) u`` on slip (the
   wheel and sled encoders' clocks apart).
@@ -72,10 +69,11 @@ import numpy as np
 from scipy import optimize, special
 
 from run_results.native import MIN_SAMPLES_PER_BIN, channel_samples, hub_samples
-from run_results.phase_average import phase_average, phase_bins
+from run_results.phase_average import phase_average
 from run_results.rest_readings import RestReadings, resolution
 from run_results.stats import PitchBatches, QuantityStats
 from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
+from swtlab.order_stats import median
 
 #: quantity -> (load-cell column, divide by the wheel radius?) for the single-cell quantities
 CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),
@@ -352,50 +350,20 @@ def _quantisation(q: float, spread: float) -> float:
     return q / math.sqrt(12) * math.exp(-2 * math.pi**2 * (spread / q) ** 2)
 
 
-def sawtooth_variance(phase: np.ndarray, weight: np.ndarray) -> float:
-    """Variance, over the place ``x`` of the jump (uniform on the period), of the error of
-    ``sum(weight * s(phase - x))`` as the mean of a unit sawtooth ``s(v) = frac(v) - 1/2``
-    (period 1, one jump of 1, mean 0), ``weight`` summing to 1. With ``cov(s(a - x), s(b - x))
-    = 1/12 - d (1 - d)/2``, ``d = |a - b|`` (Fourier series of the sawtooth), it is
-    ``1/12 - (sum_ij w_i w_j |a_i - a_j| - 2 sum w a^2 + 2 (sum w a)^2)/2``, summed in
-    ``O(n log n)`` on the sorted phases. ``m`` equally spaced phases (a grid that repeats each
-    period): ``1/(12 m^2)``, the rectangle rule's ``+-1/(2m)`` rectangular; a grid that slips
-    through the period over the window: much less (the periods' errors cancel)."""
-    order = np.argsort(phase)
-    a, w = phase[order], weight[order]
-    before_w, before_wa = np.cumsum(w) - w, np.cumsum(w * a) - w * a
-    pairs = 2.0 * float(np.sum(w * (a * before_w - before_wa)))
-    spread = pairs - 2.0 * float(np.sum(w * a * a)) + 2.0 * float(np.sum(w * a)) ** 2
-    return max(1.0 / 12.0 - spread / 2.0, 0.0)
-
-
 def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -> Term | None:
-    """The error of the mean of the phase-bin means (``phase_average``) of a periodic wave
-    with a jump, from the samples' own phases: the jump's place relative to them is unknown,
-    taken uniform on the period (GUM 4.3.7, JCGM 101:2008 for propagating the distribution),
-    so the standard uncertainty is ``D sqrt(V)``, ``V`` the :func:`sawtooth_variance` of the
-    samples' phases with the estimator's weights ``1/(B n_b)``. It covers a grid that repeats
-    each period (``V = 1/(12 m^2)``: the earlier bound ``drop/(2m)`` rectangular) and one that
-    slips through the period, whose error the window averages down (and which the residual's
-    batch means see as well, so the fixed bound counted it twice). The jump ``D`` is taken
-    at its bound, the waveform's peak-to-peak: the wave's values on either side of a jump lie
-    within its range, and a jump between two samples of one phase bin is read from adjacent
-    bins as a smaller step. Rectangular (exactly so where the grid repeats). None without a
-    frequency or samples."""
+    """Bound ``drop / (2 m)`` on the window mean of a periodic wave sampled ``m`` times a
+    period (module doc), as a rectangular term; None without a frequency or samples."""
     if not frequency_hz or y.size < 2:
         return None
-    index, bins = phase_bins(t_s, frequency_hz)
-    average = phase_average(t_s, y, frequency_hz, (index, bins))
-    if y.size < MIN_SAMPLES_PER_BIN * bins:
+    average = phase_average(t_s, y, frequency_hz)
+    if y.size < MIN_SAMPLES_PER_BIN * average["bins"]:
         return None
-    counts = average["counts"]
-    wave = average["waveform"][counts > 0]
+    wave = average["waveform"][np.isfinite(average["waveform"])]
     if wave.size < 2:
         return None
-    weight = 1.0 / (wave.size * counts[index])
-    phase = np.mod(frequency_hz * (t_s - t_s[0]), 1.0)
-    return Term(float(np.ptp(wave)) * math.sqrt(sawtooth_variance(phase, weight)),
-                rectangular=True)
+    drop = float(np.max(np.abs(np.diff(np.append(wave, wave[0])))))
+    per_period = 1.0 / (frequency_hz * float(median(np.diff(t_s))))
+    return Term(drop / (2.0 * per_period) / math.sqrt(3.0), rectangular=True)
 
 
 def _statistical(s: QuantityStats) -> Term:

@@ -187,45 +187,19 @@ def test_an_unstated_clock_is_said_to_be_assumed():
         BudgetParams(-1.0)
 
 
-@pytest.mark.parametrize(("m", "periods"), [(40.0, 20), (40.5, 20), (40.13, 10)])
-def test_phase_sampling_is_the_spread_of_a_sawtooths_sampled_mean_over_the_jumps_place(
-        m, periods):
-    """A sawtooth (rise 0 -> 1, drop 1, mean 1/2) sampled m times a period over whole periods
-    (f = 0.5 Hz), its jump at 4,000 places across the period: the rms error of the mean of the
-    phase-bin means (computed here by brute force) against the term, which is the
-    waveform's peak-to-peak (0.93-0.95 read from bins of 2-3 samples) times that rms from
-    the sample phases alone. A grid that repeats (m = 40; 19 bins, so the bins weigh the
-    phases unevenly) errs by 1.36 times the rectangle rule's 1/(m sqrt 12), one that slips
-    half a spacing a period (40.5) by 0.69 of it, one that drifts through the period over
-    the window (40.13, 10 periods) by 0.22: the periods' errors cancel. The earlier term,
-    drop/(2m)/sqrt(3) whatever the grid, was 0.74 / 1.45 / 4.6 times this one."""
-    from run_results.phase_average import phase_average
+def test_phase_sampling_bounds_the_mean_of_a_sharp_wave_seen_m_times_a_period():
+    """A sawtooth (rise 0 -> 1, drop 1) sampled m = 40 times a period: the sample mean errs
+    by up to 1/(2m) (by hand: mean of frac(phi + k/m) = (m-1)/(2m) + phi'); the term is
+    drop/(2m)/sqrt(3) with the drop read from the phase-averaged waveform (20 bins: 0.95)."""
     from run_results.uncertainty_budget import phase_sampling
 
-    f = 0.5
-    t = np.arange(round(m * periods)) / (m * f)
-    errors = [phase_average(t, np.mod(f * t - x, 1.0), f)["mean"] - 0.5
-              for x in (np.arange(4000) + 0.37) / 4000]
-    rms = float(np.sqrt(np.mean(np.square(errors))))
-    y = np.mod(f * t + 0.3, 1.0)
-    peak_to_peak = float(np.nanmax(phase_average(t, y, f)["waveform"])
-                         - np.nanmin(phase_average(t, y, f)["waveform"]))
-    term = phase_sampling(t, y, f)
-    print(f"m {m}: rms error {rms:.2e}, term {term.u:.2e}, peak-to-peak {peak_to_peak:.3f}")
-    assert term.rectangular and term.u == pytest.approx(peak_to_peak * rms, rel=0.02)
-    assert 0.9 <= peak_to_peak <= 1.0
+    m, f = 40, 0.5
+    t = np.arange(0, 40.0, 1 / (m * f))
+    errors = [np.mod(f * t + phi, 1.0).mean() - 0.5 for phi in np.linspace(0, 1, 97)]
+    assert max(map(abs, errors)) == pytest.approx(1 / (2 * m), rel=0.02)
+    term = phase_sampling(t, np.mod(f * t + 0.3, 1.0), f)
+    assert term.rectangular and term.u == pytest.approx(0.95 / (2 * m) / math.sqrt(3), rel=0.02)
     assert phase_sampling(t, np.mod(f * t, 1.0), None) is None
-
-
-def test_sawtooth_variance_of_a_repeating_grid_by_hand():
-    """m equal phases k/m, weights 1/m: the rectangle rule on a unit sawtooth errs uniformly
-    within +-1/(2m), variance 1/(12 m^2); a single phase: the sawtooth's own 1/12."""
-    from run_results.uncertainty_budget import sawtooth_variance
-
-    for m in (1, 7, 40):
-        phase = np.arange(m) / m
-        assert sawtooth_variance(phase, np.full(m, 1.0 / m)) == pytest.approx(
-            1 / (12 * m * m), rel=1e-9)
 
 
 def test_rectangle_plus_a_vanishing_normal_is_the_rectangle():
