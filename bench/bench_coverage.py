@@ -9,10 +9,11 @@ Seeds used while tuning the budget: virtual 101, 102; second rig 201 (for the op
 ``settling_overshoot`` detector and for the whole-pitch batch means of the statistical
 term, 101 and 201 alone; for the zero's age between stated bounds, 201, 245 and 246; for
 the drift's walk left out of the statistical term, 101, 102, 149, 150 and 201; for the
-torque diagnosis and the phase-sampling change tried and not kept, 101, 102 and 201).
+torque diagnosis and the phase-sampling changes tried and not kept, 101, 102 and 201).
 Reported here, fresh since that tuning: virtual 153 and 154, second rig 251 and 252 (quick:
 60 runs of the first seed each; 141-152 and 241-250 were earlier rounds' fresh seeds and
-have been looked at). Other seeds: edit ``SEEDS``, or call
+have been looked at, and 155, 156, 253 and 254 judged a phase-sampling change that was not
+kept: the next round's fresh seeds start at 157 and 255). Other seeds: edit ``SEEDS``, or call
 ``validation.coverage.run_coverage(folder, generator, runs, seed)``. Coverage comes with its
 Wilson 95 % interval (200 runs: about +-3 points at 95 %).
 """
