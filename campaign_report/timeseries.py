@@ -56,8 +56,11 @@ GRID_COLOUR, GRID_OPACITY = "#b0b0b0", 0.3
 FONT = "DejaVu Sans,Bitstream Vera Sans,Arial,sans-serif"
 SUBPIXELS = 10  # trace coordinates in tenths of a pixel
 #: how far beyond its panel a trace point is kept (panel heights): further ones are pulled
-#: in to this (clipped away, the line's direction inside the panel unchanged to the eye)
-CLAMP_PANELS = 50.0
+#: in to this (clipped away; inside the panel the line moves by under a tenth of a pixel)
+CLAMP_PANELS = 5.0
+#: path numbers (tenths of a pixel) written by table lookup, a tenth of ``str``'s time
+_INT_TEXT_LIMIT = 1 << 15
+_INT_TEXT = np.array([str(i) for i in range(-_INT_TEXT_LIMIT, _INT_TEXT_LIMIT)], dtype=object)
 
 
 def nice_ticks(lo: float, hi: float, max_bins: int) -> np.ndarray:
@@ -140,9 +143,16 @@ def _path(t_s: np.ndarray, values: np.ndarray, x_scale: float, x_lo: float, heig
     for s, e in zip(starts, ends):
         steps = np.empty((e - s - 1, 2), np.int64)
         steps[:, 0], steps[:, 1] = np.diff(xi[s:e]), np.diff(yi[s:e])
-        parts.append(f"M{xi[s]} {yi[s]}" + ("l" + " ".join(map(str, steps.ravel().tolist()))
+        parts.append(f"M{xi[s]} {yi[s]}" + ("l" + _int_text(steps.ravel())
                                             if e - s > 1 else ""))  # alone: not drawn
     return "".join(parts)
+
+
+def _int_text(values: np.ndarray) -> str:
+    """Integers as text, separated by spaces."""
+    if values.size and np.abs(values).max() < _INT_TEXT_LIMIT:
+        return " ".join(_INT_TEXT[values + _INT_TEXT_LIMIT].tolist())
+    return " ".join(map(str, values.tolist()))
 
 
 def _text(x: float, y: float, text: str, size: float = FONT_PX, anchor: str = "middle",
