@@ -238,3 +238,17 @@ def test_text_from_the_database_is_escaped():
     root = _svg(_run(_traces(), run_id='run <"&$x$'))
     lines = [t.text for t in root.findall(".//g[@class='title']/text")]
     assert lines[0].startswith('run <"&$x$: ')
+
+
+@pytest.mark.parametrize("values", [np.full(50, 3.0), np.full(50, np.nan), np.array([2.0]),
+                                    np.array([np.nan, 1.0, np.nan, 2.0])])
+def test_degenerate_traces_give_a_well_formed_drawing_with_labelled_axes(values):
+    t = np.linspace(0.0, 10.0, values.size) if values.size > 1 else np.array([5.0])
+    traces = {k: Trace(t_s=t, values=values.astype(np.float32), unit="", samples=values.size,
+                       block=1) for k in TRACE_QUANTITIES}
+    root = _svg(_run(traces, window=(5.0, 5.0)))
+    for key in TRACE_QUANTITIES:
+        labels = root.find(f".//g[@class='yticks'][@data-quantity='{key}']")
+        values_shown = [_number(t.text) for t in labels.findall("text")]
+        assert len(values_shown) >= 1 and all(np.isfinite(values_shown))
+    assert len(root.findall(".//g[@class='xticks']/text")) >= 2
