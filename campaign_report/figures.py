@@ -4,218 +4,25 @@ in every figure (:class:`campaign_report.style.Palette`)."""
 
 from __future__ import annotations
 
-import textwrap
 import warnings
 
-import matplotlib
 import numpy as np
 import pandas as pd
 from matplotlib.container import ErrorbarContainer
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
-from matplotlib.ticker import MaxNLocator
 
-from campaign_report.data import RunRecord, SetKey
-from campaign_report.images import Rendered, canvas_of, pixels
+from campaign_report.data import SetKey
 from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
                                    plain_text)
 from fitting import CurveFit, ValidationResult, band, curves_by_load, interpolate_load
-from run_results.traces import TRACE_QUANTITIES
 from sim_gap.vocabulary import SLIP_BAND_EDGES, slip_band_labels
 from wpm_export import WheelPerformanceModule
 
-#: what an axis says for a run processed before traces were stored
-NOT_STORED = "trace not stored; re-run swtlab process"
-WINDOW_COLOUR = "#cfe3cf"
 CURVE_POINTS = 200
 MARKER_PT = 5.0  # marker size of the curves' points
 NORMAL_K = 1.96  # coverage factor of a 95 % interval without a budget
-#: tick intervals of the time-series axes (time, each quantity); fewer ticks, less drawing
-TIME_BINS, VALUE_BINS = 6, 4
-#: where the time-series axis labels sit (axes fraction): fixed, so the four y labels line up
-#: and no draw measures the tick labels to place them
-YLABEL_X, XLABEL_Y = -0.075, -0.32
-
-
-def _robust_limits(ax, values: np.ndarray) -> None:
-    """Y limits from the 0.5-99.5 % range, so one spike at a run's start does not flatten it."""
-    finite = values[np.isfinite(values)]
-    if finite.size < 2:
-        return
-    lo, hi = np.percentile(finite, [0.5, 99.5])
-    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.1
-    ax.set_ylim(lo - pad, hi + pad)
-
-
-def _no_data(ax, text: str):
-    return ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4",
-            bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.85})
-
-
-def _show(artist, label: str | None) -> None:
-    """Show ``artist`` with its legend ``label``; None: hide it, out of the legend."""
-    artist.set_visible(label is not None)
-    artist.set_label("_hidden" if label is None else label)
-
-
-class RunTimeseries:
-    """One figure of drawbar pull, torque, sinkage and slip against time, reused for every
-    run of a page: its axes, ticks, labels and grid are made once and each :meth:`draw`
-    replaces only the run's own artists (a figure made anew per run spent most of its time
-    creating ticks)."""
-
-    def __init__(self, palette: Palette) -> None:
-        self.palette = palette
-        # fixed margins: constrained layout would double the cost
-        self.figure = Figure(figsize=(8.0, 6.4))
-        # one time range set on all four (sharex would make each axis measure the tick
-        # labels of the others at every draw)
-        self.axes = self.figure.subplots(len(TRACE_QUANTITIES), 1)
-        for ax, key in zip(self.axes, TRACE_QUANTITIES):
-            ax.set_ylabel(QUANTITIES[key].axis_label)
-            ax.yaxis.set_label_coords(YLABEL_X, 0.5)
-            ax.xaxis.set_major_locator(MaxNLocator(TIME_BINS))
-            ax.yaxis.set_major_locator(MaxNLocator(VALUE_BINS))
-            ax.grid(alpha=0.3)
-            # fixed also where empty: an axis placing its label measures its tick labels
-            ax.xaxis.set_label_coords(0.5, XLABEL_Y)
-            if ax is not self.axes[-1]:
-                ax.tick_params(labelbottom=False)
-        self.axes[-1].set_xlabel(QUANTITIES["t_s"].axis_label)
-        self.title = self.figure.suptitle("", fontsize="medium")
-        # each axis's window, mean and trace, shown or hidden and given each run's data
-        # (made once: creating them was two thirds of a run's artist time)
-        self._kept = [(ax.axvspan(0.0, 1.0, color=WINDOW_COLOUR, zorder=0),
-                       *ax.plot([], [], color="k", ls="--", lw=1.2),
-                       *ax.plot([], [], lw=0.8)) for ax in self.axes]
-        self._drawn: list = []  # the other artists of the run drawn last
-        self._legends: dict = {}  # (labels, trace colour) -> legend
-        self._backgrounds: dict = {}  # (legend, axes' top) -> pixels of the fixed parts
-
-    def _clear(self) -> None:
-        for artist in self._drawn:
-            artist.remove()
-        self._drawn = []
-        for kept in self._kept:
-            for artist in kept:
-                _show(artist, None)
-        for ax in self.axes:
-            ax.set_autoscale_on(True)
-
-    def _limits(self) -> None:
-        """Each axis's data limits from this run's shown artists only, autoscaled where no
-        limit was set."""
-        for ax in self.axes:
-            ax.relim(visible_only=True)
-            ax.autoscale_view()
-
-    def _time_range(self) -> None:
-        """The time span of the run's artists on all four axes, with the default margins."""
-        spans = [ax.dataLim.intervalx for ax in self.axes
-                 if np.isfinite(ax.dataLim.intervalx).all()]
-        lo, hi = (min(s[0] for s in spans), max(s[1] for s in spans)) if spans else (0.0, 1.0)
-        pad = matplotlib.rcParams["axes.xmargin"] * (hi - lo) if hi > lo else 0.5
-        for ax in self.axes:
-            ax.set_xlim(lo - pad, hi + pad)
-
-    def _legend(self, colour: str) -> None:
-        labelled = {}
-        for ax in self.axes:
-            labelled.update(zip(*reversed(ax.get_legend_handles_labels())))
-        key = (tuple(labelled), colour)
-        if key not in self._legends:
-            self._legends[key] = self.figure.legend(
-                labelled.values(), labelled.keys(), loc="lower center", ncols=len(labelled),
-                frameon=False, fontsize="small")
-        self.figure.legends[:] = [self._legends[key]]
-
-    def draw(self, run: RunRecord) -> Figure:
-        """The figure showing ``run``: its stored traces (min/max per block,
-        ``run_results.traces``), the stable window shaded with each quantity's mean over it;
-        a run with no stable phase gets the reason in its title. A run processed before
-        traces were stored says so (and shows its stored DP trace, if it has no stable
-        phase)."""
-        self._clear()
-        top = 0.93 if run.status != "no_stable_phase" else 0.86
-        self.figure.subplots_adjust(left=0.1, right=0.98, bottom=0.13, top=top, hspace=0.12)
-        colour = self.palette.colour(run.load_n)
-        drawn = self._drawn
-        for ax, key, (span, mean_line, trace_line) in zip(self.axes, TRACE_QUANTITIES,
-                                                           self._kept):
-            q = QUANTITIES[key]
-            y_data = False
-            if run.window_start_s is not None and run.window_end_s is not None:
-                span.set_x(run.window_start_s)
-                span.set_width(run.window_end_s - run.window_start_s)
-                _show(span, "stable window")
-                if key in run.means:
-                    mean = run.means[key] * q.scale  # a Line2D: a third of hlines' cost
-                    mean_line.set_data([run.window_start_s, run.window_end_s], [mean, mean])
-                    _show(mean_line, "mean over window")
-                    y_data = True
-            trace = None if run.traces is None else run.traces.get(key)
-            if trace is not None:
-                values = np.asarray(trace.values, float) * q.scale
-                trace_line.set_data(trace.t_s, values)
-                trace_line.set_color(colour)
-                _show(trace_line, "stored trace")
-                _robust_limits(ax, values)
-                continue
-            drawn.append(_no_data(ax, NOT_STORED if run.traces is None else "not measured"))
-            if key == "dp_n" and run.traces is None and run.dp_trace:  # older results: this
-                dp = np.array([np.nan if v is None else v for v in run.dp_trace["dp_n"]], float)
-                drawn += ax.plot(run.dp_trace["t_s"], dp, color="k", lw=1.0,
-                                 label="stored DP trace")
-                y_data = True
-            if not y_data:
-                ax.set_ylim(0.0, 1.0)
-        self._limits()
-        self._time_range()
-        self._legend(colour)
-        title = (f"{plain_text(run.run_id)}: {run.mode}, {run.load_n:g} N, multipass "
-                 f"{run.multipass}" + (f", slip set {100 * run.slip_setpoint:g} %"
-                                       if run.slip_setpoint is not None else ""))
-        if run.status == "no_stable_phase":
-            reason = plain_text("; ".join(run.flags))
-            title += "\n" + "\n".join(textwrap.wrap(reason, 110))
-        self.title.set_text(title)
-        self.title.set_color("#a00000" if run.status != "ok" else "k")
-        return self.figure
-
-    def render(self, run: RunRecord) -> Rendered:
-        """``run``'s figure (:meth:`draw`) as :func:`images.render` draws it, in less time:
-        the parts that are the same for many runs (axis labels, legend) are drawn once per
-        legend and layout and copied in, and only the axes (labels hidden) and the title are
-        drawn per run. Same pixels: the fixed parts overlap nothing drawn per run."""
-        figure = self.draw(run)
-        canvas = canvas_of(figure)
-        renderer = canvas.get_renderer()
-        labels = [axis.label for ax in self.axes for axis in (ax.xaxis, ax.yaxis)]
-        key = (*map(id, figure.legends), figure.subplotpars.top)
-        if key not in self._backgrounds:
-            renderer.clear()
-            figure.patch.draw(renderer)
-            for fixed in labels + figure.legends:
-                fixed.draw(renderer)
-            self._backgrounds[key] = canvas.copy_from_bbox(figure.bbox)
-        canvas.restore_region(self._backgrounds[key])
-        for label in labels:
-            label.set_visible(False)
-        try:
-            for ax in self.axes:
-                ax.apply_aspect()
-                ax.draw(renderer)
-            self.title.draw(renderer)
-        finally:
-            for label in labels:
-                label.set_visible(True)
-        return pixels(canvas)
-
-
-def run_timeseries(run: RunRecord, palette: Palette) -> Figure:
-    """One run's time-series figure on a figure of its own (:class:`RunTimeseries`)."""
-    return RunTimeseries(palette).draw(run)
 
 
 def expanded_uncertainty(rows: pd.DataFrame, key: str) -> pd.Series | None:

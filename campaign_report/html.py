@@ -1,6 +1,8 @@
-"""One self-contained HTML page: inline CSS, every image a base64 PNG ``data:`` URI, no
-script, font or link that would need a network. Thumbnails open full size through a CSS
-``:target`` lightbox (a plain ``#fragment`` link; back or the close link returns)."""
+"""One self-contained HTML page: inline CSS, every image a base64 PNG ``data:`` URI or an
+inline SVG drawing, no script, font or link that would need a network. Thumbnails open full
+size through a CSS ``:target`` lightbox (a plain ``#fragment`` link; back or the close link
+returns); a drawing's lightbox shows the thumbnail's own drawing again (``<use>``), so it is
+in the page once."""
 
 from __future__ import annotations
 
@@ -29,13 +31,14 @@ tr.flagged td{background:#fff6df}tr.no_stable_phase td,tr.failed td{background:#
 .gallery{display:grid;grid-template-columns:repeat(auto-fill,minmax(300px,1fr));gap:12px}
 .gallery figure{margin:0;border:1px solid #e3e3e3;padding:4px;background:#fff}
 .gallery figure.no_stable_phase{border-color:#b42318}.gallery figure.flagged{border-color:#9a6700}
-.gallery img{width:100%;height:auto;display:block}
+.gallery img,.gallery svg{width:100%;height:auto;display:block}
 figcaption{font-size:12px;color:#333;margin-top:2px}
 figure.full{margin:.5em 0}figure.full img{max-width:100%;height:auto}
 .lightbox{display:none;position:fixed;inset:0;background:rgba(20,20,20,.82);z-index:10;
  align-items:center;justify-content:center}
 .lightbox:target{display:flex}.lightbox a{display:block;max-width:96vw;max-height:96vh}
 .lightbox img{max-width:96vw;max-height:92vh;background:#fff;display:block}
+.lightbox svg{width:min(800px,96vw,115vh);height:auto;background:#fff;display:block}
 .lightbox span{color:#fff;font-size:13px}
 footer{max-width:1280px;margin:2em auto;padding:0 20px;color:#666;font-size:12px}
 """
@@ -50,6 +53,24 @@ class Image:
     png: bytes
     thumb: bytes | None = None
     css_class: str = ""
+
+
+@dataclass(frozen=True)
+class Drawing:
+    """An inline SVG figure (``svg``: one ``<svg>`` element whose drawing is the group of id
+    :meth:`drawing_id`, with ``viewBox`` 0 0 ``width`` ``height``), shown as a thumbnail
+    that opens it full size."""
+
+    anchor: str
+    caption: str
+    svg: str
+    width: int
+    height: int
+    css_class: str = ""
+
+    @property
+    def drawing_id(self) -> str:
+        return f"{self.anchor}-drawing"
 
 
 @dataclass(frozen=True)
@@ -75,7 +96,7 @@ class Heading:
     text: str
 
 
-Block = Image | Table | Note | Heading
+Block = Image | Drawing | Table | Note | Heading
 
 
 @dataclass(frozen=True)
@@ -125,6 +146,20 @@ def _lightbox(img: Image) -> str:
             f"<span>{escape(img.caption)} (click to close)</span></a></div>")
 
 
+def _drawing_thumbnail(d: Drawing) -> str:
+    caption = escape(d.caption)
+    return (f'<figure id="{d.anchor}" class="{escape(d.css_class)}">'
+            f'<a href="#full-{d.anchor}">{d.svg}</a><figcaption>{caption}</figcaption></figure>')
+
+
+def _drawing_lightbox(d: Drawing) -> str:
+    caption = escape(d.caption)
+    return (f'<div class="lightbox" id="full-{d.anchor}"><a href="#{d.anchor}" title="close">'
+            f'<svg viewBox="0 0 {d.width} {d.height}" width="{d.width}" height="{d.height}" '
+            f'role="img" aria-label="{caption}"><use href="#{d.drawing_id}"/></svg>'
+            f"<span>{caption} (click to close)</span></a></div>")
+
+
 def _full(img: Image) -> str:
     return (f'<figure class="full" id="{img.anchor}"><img src="{data_uri(img.png)}" '
             f'alt="{escape(img.caption)}"><figcaption>{escape(img.caption)}</figcaption></figure>')
@@ -141,6 +176,10 @@ def _section(section: Section) -> tuple[str, list[str]]:
             gallery.clear()
 
     for block in section.blocks:
+        if isinstance(block, Drawing):
+            gallery.append(_drawing_thumbnail(block))
+            lightboxes.append(_drawing_lightbox(block))
+            continue
         if isinstance(block, Image) and block.thumb is not None:
             gallery.append(_thumbnail(block))
             lightboxes.append(_lightbox(block))

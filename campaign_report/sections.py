@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
-from functools import lru_cache
+from dataclasses import replace
 from html import escape
 
-from campaign_report import figures
+from campaign_report import figures, timeseries
 from campaign_report.data import CampaignData, RunRecord
-from campaign_report.html import Heading, Image, Note, Section, Table
-from campaign_report.images import png, thumbnail, to_png
+from campaign_report.html import Drawing, Heading, Image, Note, Section, Table
+from campaign_report.images import to_png
 from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from run_results.traces import MAX_TRACE_POINTS
 from wpm_export import WheelPerformanceModule
@@ -88,22 +88,19 @@ def runs_section(data: CampaignData) -> Section:
         header, rows, numeric=numeric, row_classes=classes, html_columns=frozenset({0, 6}))])
 
 
-@lru_cache(maxsize=1)
-def _timeseries_figure(palette: Palette) -> figures.RunTimeseries:
-    """The time-series figure of the page whose palette this is, reused for all its runs."""
-    return figures.RunTimeseries(palette)
-
-
-def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Image:
-    """A run's time-series thumbnail/full-size pair; the caption says so when the run was
-    processed before its traces were stored."""
-    image = _timeseries_figure(palette).render(run)
+def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Drawing:
+    """A run's time series (:func:`timeseries.timeseries_svg`), shown as a thumbnail that
+    opens full size; the caption says so when the run was processed before its traces were
+    stored."""
+    anchor = run_anchor(index)
     caption = (f"{run.run_id} · {run.status}"
-               + (f" · {figures.NOT_STORED}" if run.traces is None else ""))
-    return Image(run_anchor(index), caption, png(image), thumbnail(image), run.status)
+               + (f" · {timeseries.NOT_STORED}" if run.traces is None else ""))
+    drawing = Drawing(anchor, caption, "", timeseries.WIDTH_PX, timeseries.HEIGHT_PX,
+                      run.status)
+    return replace(drawing, svg=timeseries.timeseries_svg(run, palette, drawing.drawing_id))
 
 
-def timeseries_section(images: Iterable[Image]) -> Section:
+def timeseries_section(images: Iterable[Image | Drawing]) -> Section:
     return Section(TIMESERIES, "Time series per run", [Note(
         "Drawbar pull, torque, sinkage and slip as stored by processing (each channel's "
         f"minimum and maximum per block of samples, at most {MAX_TRACE_POINTS} points: the "

@@ -9,6 +9,7 @@ each, <stem>-<campaign>.html beside it, or only --campaign NAME's page to -o.
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import sys
 from pathlib import Path
@@ -32,10 +33,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sqlalchemy.exc import SQLAlchemyError
+    # the imports make long-lived objects (modules, classes, registries): no cyclic garbage
+    # collection while they load, and none of them traversed by the later ones (gc.freeze):
+    # 0.6 s less CPU of the sample campaign's 6-9 s (issue 19 item 5)
+    gc.disable()
+    try:
+        from sqlalchemy.exc import SQLAlchemyError
 
-    from campaign_report import write_report, write_reports
-    from swtlab_cli.progress import progress
+        from campaign_report import write_report, write_reports
+        from swtlab_cli.progress import progress
+    finally:
+        gc.freeze()
+        gc.enable()
 
     def bar(items: list, desc: str):
         return progress(items, desc=desc, quiet=args.quiet)

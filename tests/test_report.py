@@ -7,6 +7,7 @@ import base64
 import json
 import re
 import shutil
+import xml.etree.ElementTree as ET
 from dataclasses import replace
 from html import unescape
 from pathlib import Path
@@ -16,13 +17,14 @@ import numpy as np
 import pytest
 from sqlalchemy import select, update
 
-from campaign_report import extensions, figures, page_paths, sections, write_report
+from campaign_report import extensions, figures, page_paths, sections, timeseries, write_report
 from campaign_report.data import campaign_names, gather
 from campaign_report.extensions import Extension, optional_sections, register, unregister
 from campaign_report.html import Image, Note, Section
 from campaign_report.style import Palette
 from swtlab_cli import exit_codes
 from test_report_campaign import FLAG, FLAGGED_RUN, NO_STABLE_RUN, build_small_campaign
+from test_report_timeseries import _maps
 from traceability import open_database
 from traceability.models import Campaign, Run, TestCondition, WpmExport
 from traceability.queries import latest_results
@@ -77,7 +79,14 @@ def test_page_is_self_contained_and_every_image_decodes(small):
                              cv2.IMREAD_COLOR)
         assert image is not None and image.shape[0] > 0 and image.std() > 5
         widths.append(image.shape[1])
-    assert widths.count(300) >= 20  # one thumbnail per run
+    # one thumbnail per run: its time series inline, a well-formed SVG drawing
+    drawings = re.findall(r'<figure id="run-(\d+)"[^>]*><a href="#full-run-\1">(<svg .*?</svg>)'
+                          r'</a><figcaption>', text)
+    assert len(drawings) == 20
+    for index, svg in drawings:
+        root = ET.fromstring(svg)
+        assert root.find(f".//g[@id='run-{index}-drawing']") is not None
+        assert f'<use href="#run-{index}-drawing"/>' in text  # shown again full size
     ids = set(re.findall(r'id="([^"]+)"', text))
     fragments = {h[1:] for h in references if h.startswith("#")}
     assert fragments <= ids  # every thumbnail and run link opens something on the page
@@ -113,8 +122,6 @@ def test_figures_label_every_axis_with_a_unit_and_share_load_colours(small):
     for f in data.fits:
         tested.setdefault(f.quantity, []).append(f.load_n)
     figs = {
-        "timeseries": figures.run_timeseries(run, palette),
-        "no_stable": figures.run_timeseries(nsp, palette),
         "curves": figures.performance_curves(data.points, data.fits, *key[:2],
                                              data.source.statuses, palette),
         "interpolation": figures.load_validation(data.points, data.fits, key, 120.0,
@@ -127,9 +134,17 @@ def test_figures_label_every_axis_with_a_unit_and_share_load_colours(small):
             assert UNIT.search(ax.get_ylabel()), (name, ax.get_ylabel())
             if ax.get_xlabel() or ax is fig.axes[-1]:
                 assert UNIT.search(ax.get_xlabel()), (name, ax.get_xlabel())
-    # a run with no stable phase: its stored traces and the reason
-    assert "stored trace" in figs["no_stable"].axes[0].get_legend_handles_labels()[1]
-    assert "digs in" in figs["no_stable"].get_suptitle()
+    # the time series (SVG): every axis with its unit; a run with no stable phase shows its
+    # stored traces and the reason
+    for record in (run, nsp):
+        root = ET.fromstring(timeseries.timeseries_svg(record, palette, "d"))
+        labels = [t.text for t in root.iter("text")
+                  if t.get("class") in ("ylabel", "xlabel")]
+        assert len(labels) == 5 and all(UNIT.search(label) for label in labels), labels
+    legend = [t.text for t in root.findall(".//g[@class='legend']/text")]
+    assert legend == ["stored trace"]
+    title = " ".join(t.text for t in root.findall(".//g[@class='title']/text"))
+    assert "digs in" in title
     legend = [t.get_text() for t in figs["curves"].legends[0].get_texts()]
     # the stored fits carry their covariance: the curves' bands are in the legend
     assert legend == ["70 N", "120 N", "180 N", "95 % confidence band", "95 % prediction band",
@@ -161,11 +176,17 @@ def test_time_series_shades_the_stable_window(small):
     with open_database(url)() as session:
         data = gather(session, "bb2_sand_sample")
     run = next(r for r in data.runs if r.run_id == "L070_MP0_SC_s+020")
-    fig = figures.run_timeseries(run, Palette(data.loads, data.multipasses))
-    spans = [p for p in fig.axes[0].patches]
-    assert len(spans) == 1
-    x0, x1 = spans[0].get_x(), spans[0].get_x() + spans[0].get_width()
-    assert (x0, x1) == pytest.approx((run.window_start_s, run.window_end_s))
+    root = ET.fromstring(timeseries.timeseries_svg(run, Palette(data.loads, data.multipasses),
+                                                   "d"))
+    # each panel's time axis read back from its printed tick labels (test_report_timeseries)
+    for key, m in _maps(root).items():
+        windows = m["panel"].findall("rect[@class='window']")
+        assert len(windows) == 1, key
+        x0 = float(windows[0].get("x"))
+        x1 = x0 + float(windows[0].get("width"))
+        assert (x0, x1) == pytest.approx(tuple(np.polyval(m["x"], [run.window_start_s,
+                                                                      run.window_end_s])),
+                                         abs=1.0)
 
 
 def test_a_run_processed_before_traces_were_stored_is_said_so(small):
@@ -176,10 +197,14 @@ def test_a_run_processed_before_traces_were_stored_is_said_so(small):
     nsp = replace(next(r for r in data.runs if r.run_id == NO_STABLE_RUN), traces=None)
     image = sections.timeseries_image(0, nsp, palette)
     assert image.caption.endswith("trace not stored; re-run swtlab process")
-    fig = figures.run_timeseries(nsp, palette)
+    root = ET.fromstring(image.svg)
     # its DP trace stored by processing (runs with no stable phase always had one) is shown
-    assert fig.axes[0].get_legend_handles_labels()[1] == ["stored DP trace"]
-    assert [t.get_text() for t in fig.axes[1].texts] == [figures.NOT_STORED]
+    legend = [t.text for t in root.findall(".//g[@class='legend']/text")]
+    assert legend == ["stored DP trace"]
+    maps = _maps(root)
+    assert maps["dp_n"]["panel"].find("path[@class='trace']") is not None
+    torque = [t.text for t in maps["torque_nm"]["panel"].iter("text")]
+    assert torque == [timeseries.NOT_STORED]
 
 
 def test_without_an_export_the_curves_are_fitted_here_from_ok_runs(small, tmp_path):

@@ -1,6 +1,7 @@
 """The report in a real browser: headless Chromium (Debian's package, installed by
-.ci/chromium.sh) opens the page from disk with the network off, every image decodes, nothing
-reaches the console, and a full-page screenshot is not blank.
+.ci/chromium.sh) opens the page from disk with the network off, every image decodes, every
+inline SVG time series is laid out, nothing reaches the console, a full-page screenshot is
+not blank, and a run's lightbox shows its drawing full size.
 
 How: a copy of the page gets a probe script as the first thing in <head>; it records console
 errors/warnings, error events (a broken image fires one) and unhandled rejections, and on
@@ -67,8 +68,11 @@ PROBE = """<script>
     const images = [...document.images];
     const out = document.createElement("pre");
     out.id = "probe";
+    const drawings = [...document.querySelectorAll(".gallery figure > a > svg")].map(
+      svg => { const box = svg.getBoundingClientRect();
+               return [Math.round(box.width), Math.round(box.height)]; });
     out.textContent = JSON.stringify({images: images.length, decoded: images.map(decode),
-      faults, height: document.documentElement.scrollHeight});
+      drawings, faults, height: document.documentElement.scrollHeight});
     document.body.appendChild(out);
   });
 })();
@@ -98,8 +102,14 @@ def probe(page: Path, work: Path) -> tuple[dict, list[str]]:
 
 def screenshot(page: Path, work: Path, height: int) -> np.ndarray:
     """A WIDTH x ``height`` screenshot of the page (the page itself, unprobed)."""
+    return screenshot_of(page.as_uri(), work, height)
+
+
+def screenshot_of(url: str, work: Path, height: int) -> np.ndarray:
+    """A WIDTH x ``height`` screenshot of ``url`` (a fragment opens its ``:target``)."""
     png = work / "screenshot.png"
-    done = _chromium(page.as_uri(), work / "profile-shot", f"--screenshot={png}",
+    png.unlink(missing_ok=True)
+    done = _chromium(url, work / "profile-shot", f"--screenshot={png}",
                      f"--window-size={WIDTH},{height}")
     assert png.is_file(), f"no screenshot (chromium rc {done.returncode}): {done.stderr[-800:]}"
     image = cv2.imread(str(png), cv2.IMREAD_COLOR)
@@ -127,8 +137,11 @@ def test_report_opens_in_chromium_without_errors_and_renders(tmp_path):
     url = build_small_campaign(tmp_path, runs=runs, export=False)
     page = write_report(url, tmp_path / "report.html")
     found, console = probe(page, tmp_path)
-    assert found["images"] == page.read_text().count("<img ") >= len(runs) * 2 + 1
+    assert found["images"] == page.read_text().count("<img ") >= 1  # the curve figures
     assert found["decoded"] == ["ok"] * found["images"]
+    # every run's time series, inline SVG, laid out as a thumbnail of the 800 x 640 figure
+    assert len(found["drawings"]) == len(runs)
+    assert all(w > 200 and abs(h / w - 0.8) < 0.02 for w, h in found["drawings"])
     assert found["faults"] == [] and console == []
     height = min(found["height"], MAX_HEIGHT)
     assert height > 1500
@@ -139,3 +152,12 @@ def test_report_opens_in_chromium_without_errors_and_renders(tmp_path):
     # the thumbnails' band shows plots: the page's blue accents and traces are in it
     blue = (image[:, :, 0] > 150) & (image[:, :, 2] < 100)
     assert blue.sum() > 2000
+    # a run's lightbox (opened by its fragment) shows the thumbnail's drawing again, full
+    # size (<use>): the white figure over the dark backdrop, its trace in the load colour
+    shot = screenshot_of(page.as_uri() + "#full-run-0", tmp_path, 900)
+    centre = shot[200:700, 240:1040]
+    backdrop = shot[:, :100]
+    assert (cv2.cvtColor(backdrop, cv2.COLOR_BGR2GRAY) < 80).mean() > 0.9
+    assert (cv2.cvtColor(centre, cv2.COLOR_BGR2GRAY) > 240).mean() > 0.5
+    trace = (centre[:, :, 0] > 150) & (centre[:, :, 2] < 60) & (centre[:, :, 1] < 150)
+    assert trace.sum() > 500  # the 70 N colour, #0072B2

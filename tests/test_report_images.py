@@ -1,8 +1,8 @@
 """The report's figures to PNG: palette encoding (exact where the colours fit, nearest colour
-otherwise, median cut for a non-plot), thumbnails from the same pixels, the reused
-time-series figure (a run drawn after another looks as drawn alone), the note for error
+otherwise, median cut for a non-plot), thumbnails from the same pixels, the note for error
 bars hidden by their markers (checked by hand against the axes' pixel scale), and the
-curves' bands (half-widths by hand from a known covariance)."""
+curves' bands (half-widths by hand from a known covariance). The time series are SVG
+(tests/test_report_timeseries.py)."""
 
 from __future__ import annotations
 
@@ -16,10 +16,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from campaign_report import figures, images
-from campaign_report.data import RunRecord
-from campaign_report.style import Palette
 from fitting import PowerCurve
-from run_results.traces import TRACE_QUANTITIES, Trace
 
 
 def _decoded(png: bytes) -> np.ndarray:
@@ -64,39 +61,6 @@ def test_thumbnail_is_300_px_wide_from_the_same_pixels():
     assert full.shape == (640, 800, 3) and thumb.shape == (240, 300, 3)
     assert (full == rendered.rgba[..., :3]).mean() > 0.99  # a plot: (nearly) lossless
     assert ((thumb == (0xE6, 0x9F, 0x00)).all(axis=2)).any()  # the load colour kept
-
-
-def _run(run_id: str, load_n: float, end_s: float, level: float) -> RunRecord:
-    t = np.linspace(0.0, end_s, 400)
-    traces = {k: Trace(t_s=t, values=level * (1.0 + 0.1 * np.sin(t)) * (i + 1), unit="",
-                       samples=400, block=1) for i, k in enumerate(TRACE_QUANTITIES)}
-    return RunRecord(run_id=run_id, wheel="w", soil="s", mode="speed_control", multipass=0,
-                     load_n=load_n, slip_setpoint=0.2, velocity_mps=0.01, status="ok",
-                     flags=(), window_start_s=0.3 * end_s, window_end_s=0.8 * end_s,
-                     dp_trace=None, traces=traces, means={"dp_n": level})
-
-
-def test_a_reused_time_series_figure_draws_a_run_as_a_fresh_one_does():
-    palette = Palette([70.0, 180.0], [0])
-    first, second = _run("a", 70.0, 60.0, 20.0), _run("b", 180.0, 30.0, 3.0)
-    reused = figures.RunTimeseries(palette)
-    reused.draw(first)
-    images.render(reused.figure)
-    again = images.render(reused.draw(second)).rgba
-    fresh = images.render(figures.run_timeseries(second, palette)).rgba
-    assert (again == fresh).all()
-    assert len(reused.axes[0].patches) == 1 and len(reused.figure.legends) == 1
-    assert reused.axes[0].get_xlim()[1] < 40.0  # the 60 s run's limits are gone
-
-
-def test_a_time_series_drawn_over_its_copied_fixed_parts_is_the_whole_figure_drawn():
-    palette = Palette([70.0, 180.0], [0])
-    first, second = _run("a", 70.0, 60.0, 20.0), _run("b", 180.0, 30.0, 3.0)
-    reused = figures.RunTimeseries(palette)
-    for run in (first, second, first):  # the second load's legend, then the first's again
-        fresh = images.render(figures.run_timeseries(run, palette)).rgba
-        assert (reused.render(run).rgba == fresh).all()
-    assert len(reused._backgrounds) == 2
 
 
 def test_error_bars_hidden_by_their_markers_are_named_with_their_size():
