@@ -63,6 +63,9 @@ class RunRecord:
     u: dict[str, float] = field(default_factory=dict)
     #: quantity -> 95 % expanded uncertainty of the mean (the run's budget)
     u95: dict[str, float] = field(default_factory=dict)
+    #: quantity -> the re-zeroing correction the budget added to the mean (the zero at the
+    #: rests, at the window's middle; the stored traces are before it)
+    corrections: dict[str, float] = field(default_factory=dict)
 
     @classmethod
     def from_result(cls, result: ProcessedRun) -> RunRecord:
@@ -81,7 +84,9 @@ class RunRecord:
                    u={k: float(b.u) for k, b in result.uncertainty.items()
                       if _none_if_nan(b.u) is not None},
                    u95={k: float(b.u95) for k, b in result.uncertainty.items()
-                        if _none_if_nan(b.u95) is not None})
+                        if _none_if_nan(b.u95) is not None},
+                   corrections={k: float(b.correction) for k, b in result.uncertainty.items()
+                                if _none_if_nan(b.correction) is not None})
 
 
 @dataclass(frozen=True)
@@ -187,7 +192,10 @@ def _run_records(session: Session, results: pd.DataFrame) -> list[RunRecord]:
             u={c.removesuffix("_u"): v for c in row
                if c.endswith("_u") and (v := _none_if_nan(row[c])) is not None},
             u95={c.removesuffix("_u95"): v for c in row
-                 if c.endswith("_u95") and (v := _none_if_nan(row[c])) is not None}))
+                 if c.endswith("_u95") and (v := _none_if_nan(row[c])) is not None},
+            corrections={c.removesuffix("_correction"): v for c in row
+                         if c.endswith("_correction")
+                         and (v := _none_if_nan(row[c])) is not None}))
     return runs
 
 

@@ -176,8 +176,10 @@ class _Panel:
 def timeseries_svg(run: RunRecord, palette: Palette, drawing_id: str) -> str:
     """``run``'s time series as an ``<svg>`` element (800 x 640 user units, the figure's
     pixels), its drawing in a group with id ``drawing_id`` (a second ``<svg>`` can show it
-    again with ``<use>``). The stored traces (min/max per block), the stable window shaded
-    with each quantity's mean over it; a run with no stable phase gets the reason in its
+    again with ``<use>``). The stored traces (min/max per block; each shifted by the
+    re-zeroing correction its mean carries, ``run.corrections``, so that a trace re-zeroed at
+    the rests and its mean agree), the stable window shaded with each quantity's mean over
+    it; a run with no stable phase gets the reason in its
     title, in red as every run not ``ok``. A run processed before traces were stored says so
     in its panels (and shows its stored DP trace, if it has no stable phase)."""
     colour = palette.colour(run.load_n)
@@ -196,9 +198,10 @@ def timeseries_svg(run: RunRecord, palette: Palette, drawing_id: str) -> str:
     for panel in panels:
         q = QUANTITIES[panel.key]
         trace = None if run.traces is None else run.traces.get(panel.key)
-        if trace is not None:
+        if trace is not None:  # shifted by the mean's re-zeroing, so the two agree
+            shift = run.corrections.get(panel.key, 0.0)
             series[panel.key] = (np.asarray(trace.t_s, float),
-                                 np.asarray(trace.values, float) * q.scale, colour,
+                                 (np.asarray(trace.values, float) + shift) * q.scale, colour,
                                  "stored trace", LINE_PX)
         elif panel.key == "dp_n" and run.traces is None and run.dp_trace:  # older results
             series[panel.key] = (np.asarray(run.dp_trace["t_s"], float),

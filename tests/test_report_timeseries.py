@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -130,6 +131,24 @@ def test_trace_points_map_back_to_the_stored_values_within_a_pixel():
     lo, hi = sorted(np.polyval(np.poly1d([1 / torque["y"][0], -torque["y"][1] / torque["y"][0]]),
                                [0.0, torque["height"]]))
     assert hi < 10.0 and lo > 0.0  # 500 N·m is off the axis, which spans the 3 ± 0.5 signal
+
+
+def test_a_trace_is_drawn_re_zeroed_as_its_mean():
+    """The stored traces are before the rests' re-zeroing, the means after it (sample
+    L070_MP0_FS: DP mean 0.04 N over a trace at -1.06 N): each trace is drawn shifted by its
+    mean's correction, the quantities without one as stored."""
+    traces = _traces()
+    run = replace(_run(traces), corrections={"dp_n": 1.1, "torque_nm": -0.25})
+    maps = _maps(_svg(run))
+    for key in TRACE_QUANTITIES:
+        m = maps[key]
+        path = m["panel"].find("path[@class='trace']")
+        scale = float(re.fullmatch(r"scale\(([\d.]+)\)", path.get("transform")).group(1))
+        drawn = np.concatenate(_path_points(path.get("d"), scale))
+        shifted = (traces[key].values.astype(float) + run.corrections.get(key, 0.0)) * SCALE[key]
+        expected = np.polyval(m["y"], shifted)
+        inside = (expected > -m["height"]) & (expected < 2 * m["height"])
+        assert np.abs(drawn[inside, 1] - expected[inside]).max() < 1.0
 
 
 def test_window_shading_and_mean_line_sit_at_the_window_times_and_mean():
