@@ -1,22 +1,28 @@
 """softflow: measurements from camera images (slip from the wheel track; docs/track-slip.md;
 soil velocity field under the wheel, SOFT; docs/softflow.md).
 
-The numba kernels run on numba's ``workqueue`` threading layer, which survives a fork: with
-GNU OpenMP (the layer numba picks first where it is installed) a process that has measured
-soil flow aborts when it forks, and ``swtlab process --jobs`` forks its workers ("fork()
-called from a process already using GNU OpenMP"). workqueue is not for concurrent calls
-from several Python threads: run dask workers with one thread each (docs/scale-out.md).
+The names below are loaded on first use (PEP 562), so that a reader of stored flows (the
+campaign report) does not load the flow engine and numba (``softflow.numba_layer`` sets
+numba's threading layer for every module that uses it).
 """
 
-import numba
+import importlib
 
-from softflow.field_analysis import FlowResult, analyse_frames
-from softflow.frames import FrameSet, FrameSourceError, load_frames
-from softflow.track_run import RunImageSlip, run_image_slip
-from softflow.track_slip import NoPeriodicMarksError, TrackSlipResult, measure_track_slip
+#: each public name -> the module that defines it
+_HOMES = {"FlowResult": "softflow.flow_result", "analyse_frames": "softflow.field_analysis",
+          "FrameSet": "softflow.frames", "FrameSourceError": "softflow.frames",
+          "load_frames": "softflow.frames", "RunImageSlip": "softflow.track_run",
+          "run_image_slip": "softflow.track_run", "NoPeriodicMarksError": "softflow.track_slip",
+          "TrackSlipResult": "softflow.track_slip", "measure_track_slip": "softflow.track_slip"}
 
-numba.config.THREADING_LAYER = "workqueue"  # chosen at the first parallel launch, not import
+__all__ = sorted(_HOMES)
 
-__all__ = ["FlowResult", "FrameSet", "FrameSourceError", "analyse_frames", "load_frames",
-           "NoPeriodicMarksError", "RunImageSlip", "TrackSlipResult", "measure_track_slip",
-           "run_image_slip"]
+
+def __getattr__(name: str):
+    if name in _HOMES:
+        return getattr(importlib.import_module(_HOMES[name]), name)
+    raise AttributeError(f"module 'softflow' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_HOMES))

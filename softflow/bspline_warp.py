@@ -19,9 +19,10 @@ stale copy of ``sample`` after it changed.
 from __future__ import annotations
 
 import cv2
-import numba
 import numpy as np
 from scipy import ndimage
+
+from softflow.numba_layer import numba
 
 POLES = (-0.4305753470999738, -0.04309628820326465)
 _HORIZON = 20  # 0.4306^20 < 1e-7: terms of the causal initial sum that matter

@@ -14,7 +14,7 @@ bins whose estimated ``eps`` is resolved to 0.01 (:func:`softflow.flow_checks.ep
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import cv2
 import numpy as np
@@ -23,12 +23,13 @@ from softflow.alpha12 import fit_alpha12, rates_and_sigmas
 from softflow.decay_fit import DecayFit, fit_decay_across
 from softflow.flow_checks import (alpha12_reason, check_contact_fits, check_sled_velocity,
                                   eps_reason, fit_reason)
-from softflow.flow_engine import EDGE_PX, MeanField, average_flow
+from softflow.flow_engine import EDGE_PX, average_flow
+from softflow.flow_result import FlowResult, MeanField
 from softflow.grouser_models import select_model
 from softflow.polar import beta_bins, far_field_velocity, polar_coordinates, profiles, resolve
 from softflow.threads import capped
 from softflow.volumetric_strain import FLOW_FIELD_ERROR, strain_by_beta
-from softflow.wheel_detect import (MASK_MARGIN_PX, WheelPose, smooth_pixels, soil_mask,
+from softflow.wheel_detect import (MASK_MARGIN_PX, smooth_pixels, soil_mask,
                                    track_wheel)
 
 #: profiles start this far outside the grouser tips: the soil mask's margin, the flow engine's
@@ -71,88 +72,6 @@ def fit_profiles(prof: list, rim_px: float, px_per_m: float, bins=None) -> list:
                                   [prof[m][2] for m in idx], np.array(near, float) * width,
                                   near.index(0))
     return out
-
-
-@dataclass
-class FlowResult:
-    """Everything measured on one frame range; ``to_dict()`` is what the database stores."""
-
-    px_per_m: float
-    t_s: np.ndarray
-    frame_range: tuple[int, int]
-    poses: list[WheelPose]
-    mean: MeanField
-    sled_velocity_mps: tuple[float, float]  # (x right, y down), image axes
-    beta_rad: np.ndarray
-    radial: list[DecayFit | None]
-    tangential: list[DecayFit | None]
-    profiles_r: list = field(default_factory=list)
-    profiles_t: list = field(default_factory=list)
-    grouser: dict | None = None
-    alpha12: dict | None = None
-    engine: str = "deform-lk"
-    source: str = ""
-    eps_vol_p: np.ndarray | None = None  # per beta bin, compression positive
-    eps_source: str | None = None  # "given" or "estimated"
-    eps_depth_m: float | None = None  # estimated: taken this far outside the wheel
-    eps_bound: np.ndarray | None = None  # estimated: uncertainty bound per beta bin
-    eps_reason: list = field(default_factory=list)  # per bin: why eps is not resolved
-    alpha12_reason: str | None = None  # why alpha12 is None
-    radial_reason: list = field(default_factory=list)  # per bin: why no k (None: fitted)
-    tangential_reason: list = field(default_factory=list)
-
-    def to_dict(self) -> dict:
-        p0 = self.poses[0]
-        nan = np.full(len(self.beta_rad), np.nan)
-        eps = nan if self.eps_vol_p is None else self.eps_vol_p
-        bound = nan if self.eps_bound is None else self.eps_bound
-        return {
-            "schema": "swtlab.softflow/1",
-            "source": self.source,
-            "frame_range": list(self.frame_range),
-            "t_s": [float(self.t_s[0]), float(self.t_s[-1])],
-            "pairs": len(self.t_s) - 1,
-            "engine": self.engine,
-            "px_per_m": self.px_per_m,
-            "outlier_fraction": self.mean.outlier_fraction,
-            "sled_velocity_mps": list(self.sled_velocity_mps),
-            "wheel": {"center_px_first": list(p0.center_px),
-                      "center_px_last": list(self.poses[-1].center_px),
-                      "radius_px": p0.radius_px, "grouser_count": p0.grouser_count,
-                      "grouser_height_px": p0.grouser_height_px},
-            "angle_convention": "beta: 0 at image right, counter-clockwise; velocities in the "
-                                "bin (world) frame about the axle, v_r outwards, v_theta along "
-                                "e_theta (theta from the downward vertical towards travel)",
-            "per_beta": [
-                {"beta_deg": float(np.rad2deg(b)),
-                 "k": r.to_dict() if r else None,
-                 "k_reason": rr,
-                 "alpha3": t.to_dict() if t else None,
-                 "alpha3_reason": tr,
-                 "eps_vol_p": None if np.isnan(e) else float(e),
-                 "eps_vol_p_bound": None if np.isnan(eb) else float(eb),
-                 "eps_vol_p_reason": er}
-                for b, r, t, e, eb, rr, tr, er in zip(
-                    self.beta_rad, self.radial, self.tangential, eps, bound,
-                    self._reasons(self.radial_reason), self._reasons(self.tangential_reason),
-                    self._reasons(self.eps_reason))],
-            "alpha1_alpha2": self.alpha12,
-            "alpha1_alpha2_reason": self.alpha12_reason,
-            "eps_vol_p_source": self.eps_source,
-            "eps_vol_p_depth_m": self.eps_depth_m,
-            "grouser_model": self.grouser,
-        }
-
-
-    def _reasons(self, reasons: list) -> list:
-        return reasons or [None] * len(self.beta_rad)
-
-    def resolved_eps(self) -> np.ndarray | None:
-        """``eps_vol_p`` where it is resolved (``eps_reason`` None), else NaN."""
-        if self.eps_vol_p is None:
-            return None
-        return np.where([r is None for r in self._reasons(self.eps_reason)], self.eps_vol_p,
-                        np.nan)
 
 
 def _rates(fits: list[DecayFit | None]) -> np.ndarray:

@@ -17,8 +17,7 @@ import cv2
 import numpy as np
 
 from softflow.decay_fit import DecayFit
-from softflow.field_analysis import FlowResult
-from softflow.flow_engine import MeanField
+from softflow.flow_result import FlowResult, MeanField
 from softflow.wheel_detect import WheelPose
 
 MAX_SIDE_PX = 192

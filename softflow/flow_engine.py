@@ -59,13 +59,13 @@ JPEG blocking and sensor noise: numbers at the constant.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
 
 import cv2
-import numba
 import numpy as np
 
+from softflow.numba_layer import numba
 from softflow import bspline_warp
+from softflow.flow_result import MeanField
 from softflow.threads import capped
 
 ENGINES = ("deform-lk", "farneback", "dis")
@@ -327,16 +327,6 @@ def normalised_median_outliers(flow_px: np.ndarray, valid: np.ndarray, spacing_p
     count = np.isfinite(neigh[..., 0]).sum(axis=0)
     bad = (np.nanmax(np.nan_to_num(norm, nan=np.inf), axis=-1) > threshold) | (count < 3)
     return bad & valid
-
-
-@dataclass
-class MeanField:
-    """Per-pixel mean velocity of the valid vectors of all pairs (camera frame)."""
-
-    velocity_px_per_s: np.ndarray  # (H, W, 2), NaN where no valid vector
-    count: np.ndarray  # (H, W) valid pairs per pixel
-    outlier_fraction: float
-    pair_velocities_px_per_s: list[np.ndarray]  # per pair, NaN where masked or rejected
 
 
 def _pair_flows(frames: list[np.ndarray], soil_masks: list[np.ndarray], engine: str,

@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from softflow.field_analysis import FlowResult  # noqa: E402
+from softflow.flow_result import FlowResult  # noqa: E402
 from swtlab.atomic import atomic_file  # noqa: E402
 
 

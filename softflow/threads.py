@@ -17,8 +17,8 @@ import contextlib
 import functools
 
 import cv2
-import numba
 
+from softflow.numba_layer import numba
 from swtlab.cores import available_cores
 
 

@@ -7,7 +7,7 @@ import numpy as np
 from scipy import ndimage
 
 from softflow.field_analysis import fit_profiles, jackknife_ci
-from softflow.flow_engine import MeanField
+from softflow.flow_result import MeanField
 from softflow.polar import beta_bins, polar_coordinates, profiles
 
 PX_PER_M, RIM_PX, K_PER_M, A3_PER_M = 1000.0, 40.0, 50.0, 65.0
