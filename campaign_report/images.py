@@ -120,25 +120,14 @@ def encode(rgba: np.ndarray, palette: np.ndarray | None,
     return out.getvalue()
 
 
-def canvas_of(fig: Figure, dpi: int = FULL_DPI) -> FigureCanvasAgg:
-    """``fig``'s in-memory (Agg) canvas, at ``dpi``, on white."""
+def render(fig: Figure, dpi: int = FULL_DPI) -> Rendered:
+    """``fig`` drawn once at ``dpi`` on white (its pixels copied out of the canvas), and its
+    palette."""
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     if fig.dpi != dpi:
         fig.set_dpi(dpi)
     fig.patch.set_facecolor("white")
-    return canvas
-
-
-def render(fig: Figure, dpi: int = FULL_DPI) -> Rendered:
-    """``fig`` drawn once at ``dpi`` on white (its pixels copied: a reused figure is drawn
-    again), and its palette."""
-    canvas = canvas_of(fig, dpi)
     canvas.draw()
-    return pixels(canvas)
-
-
-def pixels(canvas: FigureCanvasAgg) -> Rendered:
-    """What ``canvas`` holds now (copied: a reused figure is drawn again), and its palette."""
     rgba = np.array(canvas.buffer_rgba(), copy=True)
     return Rendered(rgba, *_palette(_keys(rgba)))
 
