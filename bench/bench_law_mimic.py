@@ -100,7 +100,7 @@ def main(quick: bool = False) -> dict:
                     own, _ = held_out_rms(base, (family,), {family: law}, points, sim, sigma)
                     others = {}
                     for other in sorted(tm.LAWS[family]):
-                        if other != law:
+                        if tm.published_law(family, other) != law:
                             rms, values = held_out_rms(base, (family,), {family: other},
                                                        points, sim, sigma)
                             others[other] = {"rms_sigma": rms, "values": values}

@@ -75,6 +75,8 @@ PARAMETERS = {
                                                              1e-3),
     "effects.multipass.elastic_stiffness_pa_m": Quantity("K_e (rut reloading stiffness)",
                                                          "MPa/m", 1e-6),
+    "effects.slip_sinkage.load_exponent": Quantity("a (load exponent of the strength)", "-"),
+    "effects.wheel_flexibility.load_exponent": Quantity("a (load exponent of the strength)", "-"),
 }
 #: the effects of the built-in model (terramechanics.EFFECTS) in plain words
 EFFECTS = {"grousers": "grousers", "slip_sinkage": "slip sinkage",

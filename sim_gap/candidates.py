@@ -100,6 +100,20 @@ def allowed_laws(model: tm.WheelModel, effects: list[str],
     return out
 
 
+#: set loads a load-varying law (``law~load``) needs: two fix its exponent, a third tests it
+MIN_LOADS_FOR_LOAD_VARYING = 3
+
+
+def for_loads(allowed: dict[str, tuple[str, ...]], n_loads: int) -> dict[str, tuple[str, ...]]:
+    """``allowed`` without the load-varying laws where the points have fewer than
+    :data:`MIN_LOADS_FOR_LOAD_VARYING` set loads (their exponent would only restate the
+    published law's strength at the loads there are), unless they are all an effect has."""
+    if n_loads >= MIN_LOADS_FOR_LOAD_VARYING:
+        return allowed
+    return {e: tuple(law for law in laws if tm.law_class(e, law).relaxes is None) or laws
+            for e, laws in allowed.items()}
+
+
 def candidate(model: tm.WheelModel, effects: tuple[str, ...],
               laws: dict[str, str] | None = None) -> Candidate:
     """Soil parameters and the strengths of ``effects`` (vocabulary order) under ``laws``

@@ -109,7 +109,8 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     asked = [e for e in (effects or sim.missing_effects()) if e in sim.missing_effects()]
     effects_ok, untestable = testable(sim, points,
                                       cands.allowed_laws(sim.model, asked, settings.laws))
-    allowed = cands.allowed_laws(sim.model, effects_ok, settings.laws)
+    allowed = cands.for_loads(cands.allowed_laws(sim.model, effects_ok, settings.laws),
+                              contrasts(points)["load"])
     sig = sigmas(points, sim.radius_m)
     n = len(points)
     results = _run_all(sim, cands.singles(sim.model, allowed), points, sig, settings)

@@ -30,7 +30,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                                      "simulation lacks)")
     p.add_argument("--laws", help="laws the candidates may use, comma-separated effect=law "
                                   "(repeat an effect for several), e.g. grousers=ding2011,"
-                                  "slip_sinkage=lyasko2010 (default: every law of each effect; "
+                                  "slip_sinkage=lyasko2010,slip_sinkage=lyasko2010~load (default: "
+                                  "every law of each effect, load-varying forms included; "
                                   "docs/gap-report.md)")
     p.add_argument("--json", help="write the report JSON here")
     p.add_argument("--html", help="write the HTML report here")

@@ -38,9 +38,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "soil's slip-sinkage from the lugs')")
     p.add_argument("--truth-laws", choices=("in-family", "held-out"), default="in-family",
                    help="in-family: the diagnosis may use every law of each effect; held-out: "
-                        "the law that made each campaign's truth is removed from the laws "
-                        "it may use, for every effect (one law of each family left out in "
-                        "turn)")
+                        "the law that made each campaign's truth (and its load-varying form) is "
+                        "removed from the laws it may use, for every effect (one law of each "
+                        "family left out in turn)")
     p.add_argument("--signal-model", choices=("testbed", "second"), default="testbed",
                    help="raw-run generator: the virtual testbed, or the second rig written "
                         "apart from it (validation.second_rig)")

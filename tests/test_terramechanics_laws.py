@@ -20,6 +20,7 @@ import pytest
 import terramechanics as tm
 from terramechanics import ding2011
 from terramechanics.effects import DEFAULT_LAWS, LAWS, law_class, make_effect
+from terramechanics.effects.load_varying import STRENGTH
 from terramechanics.effects.grousers_bekker1956 import side_shear_factors
 from terramechanics.model_file import ModelFileError, model_from_dict, model_to_dict
 
@@ -28,8 +29,8 @@ BB2 = tm.shipped_model("bb2_sand").with_effects(**{n: False for n in tm.EFFECTS}
 
 
 def test_registry_laws_declare_source_and_fit_parameters():
-    assert all(len(laws) >= 2 for laws in LAWS.values()) and len(LAWS) == 6
-    for name, laws in LAWS.items():
+    assert all(len(laws) >= 2 for laws in tm.PUBLISHED_LAWS.values()) and len(LAWS) == 6
+    for name, laws in tm.PUBLISHED_LAWS.items():
         assert tm.EFFECTS[name] is laws[DEFAULT_LAWS[name]]
         for law, cls in laws.items():
             assert cls.name == name and cls.law == law and cls.__doc__
@@ -42,6 +43,31 @@ def test_registry_laws_declare_source_and_fit_parameters():
             assert make_effect(name, law) == cls()
     with pytest.raises(KeyError, match="unknown law"):
         law_class("grousers", "magic1999")
+
+
+@pytest.mark.parametrize("name, law", [(n, law) for (n, law) in STRENGTH])
+def test_a_load_varying_law_is_its_published_law_at_each_load(name, law):
+    """``law~load`` at load W: the published law with its strength times (W / 100 N)^a;
+    at a = 0 the published law itself. Each load computed alone by the published law."""
+    varying = LAWS[name][law + "~load"]
+    published = LAWS[name][law]
+    assert varying.relaxes == law and tm.published_law(name, varying.law) == law
+    assert [p.name for p in varying.fit] == [p.name for p in published.fit] + ["load_exponent"]
+    strength = STRENGTH[(name, law)]
+    start = {p.name: p.start for p in published.fit}[strength]
+    loads, slip = np.array([70.0, 100.0, 300.0]), 0.4
+    both = BB2.with_effects(**{name: {"law": varying.law, strength: start,
+                                      "load_exponent": -0.7}}).curves(loads, slip)
+    flat = BB2.with_effects(**{name: {"law": varying.law, strength: start}}).curves(loads, slip)
+    alone = BB2.with_effects(**{name: {"law": law, strength: start}}).curves(loads, slip)
+    for q in ("dp_n", "torque_nm", "sinkage_m"):
+        assert flat[q] == pytest.approx(alone[q], rel=1e-12)
+    for i, load in enumerate(loads):
+        scaled = BB2.with_effects(**{name: {"law": law, strength: start * (load / 100.0) ** -0.7}})
+        one = scaled.curves(load, slip)
+        for q in ("dp_n", "torque_nm", "sinkage_m"):
+            assert both[q][i] == pytest.approx(float(one[q]), rel=1e-9)
+    assert abs(both["sinkage_m"][2] / alone["sinkage_m"][2] - 1) > 1e-3  # the exponent acts
 
 
 @pytest.mark.parametrize("name, law", [(n, law) for n, laws in LAWS.items() for law in laws])

@@ -125,19 +125,22 @@ def base_model() -> tm.WheelModel:
 
 
 def truth_law(campaign: int, effect: str) -> str:
-    """The law campaign ``campaign`` makes ``effect`` with (and, held out, removes)."""
-    laws = sorted(tm.LAWS[effect])
+    """The published law campaign ``campaign`` makes ``effect`` with (and, held out,
+    removes with the laws that extend it)."""
+    laws = sorted(tm.PUBLISHED_LAWS[effect])
     return laws[campaign % len(laws)]
 
 
 def diagnosis_laws(campaign: int, truth_laws: str) -> dict[str, tuple[str, ...]] | None:
     """The laws the diagnosis of campaign ``campaign`` may use: all (``None``) in family;
-    held out, every family without the law of :func:`truth_law`."""
+    held out, every family without the law of :func:`truth_law` and the laws that extend it
+    (its ``~load`` form holds it at a load exponent of 0)."""
     if truth_laws not in TRUTH_LAWS:
         raise ValueError(f"truth_laws must be one of {TRUTH_LAWS}, not {truth_laws!r}")
     if truth_laws == "in-family":
         return None
-    return {e: tuple(law for law in sorted(tm.LAWS[e]) if law != truth_law(campaign, e))
+    return {e: tuple(law for law in sorted(tm.LAWS[e])
+                     if tm.published_law(e, law) != truth_law(campaign, e))
             for e in EFFECT_NAMES}
 
 

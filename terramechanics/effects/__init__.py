@@ -14,6 +14,7 @@ from terramechanics.effects.bulldozing_bekker1969 import BulldozingBekker1969
 from terramechanics.effects.bulldozing_rankine_terzaghi1943 import BulldozingRankineTerzaghi1943
 from terramechanics.effects.grousers_bekker1956 import GrousersBekker1956
 from terramechanics.effects.grousers_ding2011 import GrousersDing2011
+from terramechanics.effects.load_varying import STRENGTH, load_varying
 from terramechanics.effects.multipass_krenn_hirzinger2009 import MultipassKrennHirzinger2009
 from terramechanics.effects.multipass_wong2010 import MultipassWong2010
 from terramechanics.effects.reduced_gravity_reece1965 import ReducedGravityReece1965
@@ -30,10 +31,22 @@ _ALL: tuple[type[Effect], ...] = (
     WheelFlexibilityBekker1969, MultipassWong2010, MultipassKrennHirzinger2009,
     BulldozingBekker1969, BulldozingRankineTerzaghi1943)
 
-#: effect -> law -> class, effects in the vocabulary's order
-LAWS: dict[str, dict[str, type[Effect]]] = {}
+#: effect -> published law -> class, effects in the vocabulary's order
+PUBLISHED_LAWS: dict[str, dict[str, type[Effect]]] = {}
 for _cls in _ALL:
-    LAWS.setdefault(_cls.name, {})[_cls.law] = _cls
+    PUBLISHED_LAWS.setdefault(_cls.name, {})[_cls.law] = _cls
+
+#: effect -> law -> class: the published laws and, for the effects of
+#: ``load_varying.STRENGTH``, each with its strength varying with the load (``law~load``)
+LAWS: dict[str, dict[str, type[Effect]]] = {e: dict(laws) for e, laws in PUBLISHED_LAWS.items()}
+for (_name, _law), _strength in STRENGTH.items():
+    _varying = load_varying(PUBLISHED_LAWS[_name][_law], _strength)
+    LAWS[_name][_varying.law] = _varying
+
+
+def published_law(name: str, law: str) -> str:
+    """The published law that ``law`` of effect ``name`` is or extends."""
+    return law_class(name, law).relaxes or law
 
 #: the law a model gets when it names none
 DEFAULT_LAWS: dict[str, str] = {
@@ -67,5 +80,6 @@ def make_effect(name: str, law: str | None = None, **params: float) -> Effect:
     return law_class(name, law)(**params)
 
 
-__all__ = ["DEFAULT_LAWS", "EFFECTS", "Effect", "FitParam", "LAWS", "SOIL_ORDER",
-           "law_class", "make_effect"] + [cls.__name__ for cls in _ALL]
+__all__ = ["DEFAULT_LAWS", "EFFECTS", "Effect", "FitParam", "LAWS", "PUBLISHED_LAWS",
+           "SOIL_ORDER", "law_class", "make_effect", "published_law"
+           ] + [cls.__name__ for cls in _ALL]

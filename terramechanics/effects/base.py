@@ -24,7 +24,8 @@ class Effect:
     """Base of the effect laws; a subclass is a frozen dataclass of its parameters.
 
     ``name`` is the effect (the diagnosis vocabulary), ``law`` the published law that
-    implements it (one module per law, named after its source). ``soil`` and
+    implements it (one module per law, named after its source; a generalised law names
+    the published law it extends in ``relaxes``). ``soil`` and
     ``geometry`` change what the stress integrals see (and so the sinkage); ``forces``
     adds forces outside the integrals once the sinkage is solved. ``fit`` lists the
     strength parameters a gap fit frees, with their bounds.
@@ -32,6 +33,7 @@ class Effect:
 
     name: ClassVar[str]
     law: ClassVar[str]
+    relaxes: ClassVar[str | None] = None  # the published law a generalised law extends
     terms: ClassVar[tuple[str, ...]] = ()  # names of the extra outputs of `forces`
     fit: ClassVar[tuple[FitParam, ...]] = ()
 
