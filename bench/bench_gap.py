@@ -1,5 +1,6 @@
 """Time of one gap diagnosis (sim_gap.diagnose) of a 100-run campaign with all six candidate
-effects under both laws of each (13 singles, 45 pairs on the one-law-at-a-time design):
+effects under every law of each (17 singles, 65 pairs on the one-law-at-a-time design; until
+0.10.0, without the load-varying laws, 13 and 45):
 5 loads x 5 slips x multipass {0, 1} x gravity {g0, Mars}, measured values from the model
 with a hidden slip-sinkage + bulldozing pair and 0.5 %-of-load noise. Goal: under 60 s on
 two cores (``jobs=2``); the CPU seconds of the fits are printed too (wall time on a shared

@@ -366,8 +366,10 @@ def test_lug_sinkage_mimics_soil_slip_sinkage_on_one_grousered_wheel():
     truth = BASE.with_soil(**TRUTH_SOIL).with_effects(slip_sinkage={"n1": 0.6})
     report = diagnose(synthetic_points(truth), Simulated(BASE), CANDIDATES, FAST)
     assert report["verdict"] == "inconclusive"
-    assert set(report["decision"]["leaders"]) == {"slip_sinkage(ding2011)",
-                                                  "grousers(ding2011)"}
+    # the slip-sinkage leader is Ding's law, published or load-varying (0.10.0: its exponent
+    # fits the noise a little better, held out as well)
+    assert {label.replace("~load", "") for label in report["decision"]["leaders"]} == {
+        "slip_sinkage(ding2011)", "grousers(ding2011)"}
     lugs = next(c for c in report["candidates"] if c["label"] == "grousers(ding2011)")
     kappa = 0.6 * BASE.wheel.radius_m / BASE.wheel.grouser_height_m  # 8.15
     assert lugs["parameters"]["effects.grousers.lug_sinkage_gain"] == pytest.approx(kappa,
