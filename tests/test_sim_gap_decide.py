@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 
 import terramechanics as tm
+from terramechanics.effects.load_varying import SUFFIX as LOAD_VARYING
 from sim_gap import candidates
 from sim_gap.decide import Z_TIE, decide, gain_over_noise, paired_z, rank
 from sim_gap.diagnose import Settings, diagnose
@@ -368,7 +369,7 @@ def test_lug_sinkage_mimics_soil_slip_sinkage_on_one_grousered_wheel():
     assert report["verdict"] == "inconclusive"
     # the slip-sinkage leader is Ding's law, published or load-varying (0.10.0: its exponent
     # fits the noise a little better, held out as well)
-    assert {label.replace("~load", "") for label in report["decision"]["leaders"]} == {
+    assert {label.replace(LOAD_VARYING, "") for label in report["decision"]["leaders"]} == {
         "slip_sinkage(ding2011)", "grousers(ding2011)"}
     lugs = next(c for c in report["candidates"] if c["label"] == "grousers(ding2011)")
     kappa = 0.6 * BASE.wheel.radius_m / BASE.wheel.grouser_height_m  # 8.15
