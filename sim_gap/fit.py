@@ -4,6 +4,7 @@ Huber 1981, Robust Statistics)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,13 +48,34 @@ def standardised_residuals(points: pd.DataFrame, predicted: dict[str, np.ndarray
     """``(measured - predicted)/sigma`` clipped to ``+-clip``, shape (points, quantities);
     NaN where not measured. A relative sinkage (``attrs['sinkage_relative']``) has its mean
     removed."""
+    quantities = quantities_of(points)
+    return _standardised(points[quantities].to_numpy(float), quantities, predicted, sigma,
+                         bool(points.attrs.get("sinkage_relative")), clip)
+
+
+def _standardised(measured: np.ndarray, quantities: list[str],
+                  predicted: dict[str, np.ndarray], sigma: dict[str, np.ndarray],
+                  sinkage_relative: bool, clip: float) -> np.ndarray:
     cols = []
-    for q in quantities_of(points):
-        r = (points[q].to_numpy(float) - predicted[q]) / sigma[q]
-        if q == "sinkage_m" and points.attrs.get("sinkage_relative"):
+    for i, q in enumerate(quantities):
+        r = (measured[:, i] - predicted[q]) / sigma[q]
+        if q == "sinkage_m" and sinkage_relative:
             r = r - np.nanmean(r)
         cols.append(np.clip(r, -clip, clip))
     return np.column_stack(cols)
+
+
+def residual_function(sim: Simulated, points: pd.DataFrame, sigma: dict[str, np.ndarray]
+                      ) -> Callable[[dict[str, float | str]], np.ndarray]:
+    """Model values -> the unclipped standardised residuals of the measured entries (flat),
+    with the points' columns read once: a fit evaluates it hundreds of times."""
+    quantities = quantities_of(points)
+    measured = points[quantities].to_numpy(float)
+    where = np.isfinite(measured)
+    relative = bool(points.attrs.get("sinkage_relative"))
+    predict = sim.predictor(points)
+    return lambda values: _standardised(measured, quantities, predict(values), sigma,
+                                        relative, np.inf)[where]
 
 
 def to_values(c: Candidate, u: np.ndarray) -> dict[str, float | str]:
@@ -102,11 +124,10 @@ def fit_candidate(sim: Simulated, c: Candidate, points: pd.DataFrame,
     u0 = to_internal(c, start) if start else to_internal(c, {p.name: p.start for p in c.params})
     u0 = np.clip(u0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
 
-    measured = np.isfinite(points[quantities_of(points)].to_numpy(float))
+    residuals_at = residual_function(sim, points, sigma)
 
     def residuals(u):
-        r = standardised_residuals(points, sim.predict(points, to_values(c, u)), sigma, np.inf)
-        return np.nan_to_num(r[measured], nan=1e3, posinf=1e3, neginf=-1e3)
+        return np.nan_to_num(residuals_at(to_values(c, u)), nan=1e3, posinf=1e3, neginf=-1e3)
 
     sol = least_squares(residuals, u0, bounds=(lo, hi), x_scale=np.maximum(hi - lo, 1e-9) / 10,
                         diff_step=1e-3, max_nfev=max_nfev, xtol=1e-4, ftol=1e-4,

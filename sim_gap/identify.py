@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from sim_gap.fit import FitResult, quantities_of, standardised_residuals, to_internal, to_values
+from sim_gap.fit import FitResult, residual_function, to_internal, to_values
 from sim_gap.simulated import Simulated
 
 #: fewest measured points per free parameter for a confident call
@@ -43,11 +43,8 @@ def jacobian(sim: Simulated, fit: FitResult, points: pd.DataFrame,
     span = np.array([np.log(p.upper / p.lower) if p.log else p.upper - p.lower
                      for p in c.params])
     u = to_internal(c, fit.values)
-    measured = np.isfinite(points[quantities_of(points)].to_numpy(float))
-
-    def r(x):
-        pred = sim.predict(points, to_values(c, x))
-        return standardised_residuals(points, pred, sigma, np.inf)[measured]
+    residuals_at = residual_function(sim, points, sigma)
+    r = lambda x: residuals_at(to_values(c, x))  # noqa: E731
 
     cols = []
     for i, h in enumerate(STEP_FRACTION * span):

@@ -9,6 +9,7 @@ model itself, ``model(theta, effects)``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -71,9 +72,12 @@ class Simulated:
 
     @staticmethod
     def _curves_at(model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
-        c = model.curves(points["wheel_load_n"].to_numpy(float), points["slip"].to_numpy(float),
-                         points["multipass"].to_numpy(float),
-                         points["gravity_mps2"].to_numpy(float))
+        return Simulated._curves_of(model, _conditions(points))
+
+    @staticmethod
+    def _curves_of(model: tm.WheelModel, conditions: tuple[np.ndarray, ...]
+                   ) -> dict[str, np.ndarray]:
+        c = model.curves(*conditions)
         return {q: c[q] for q in QUANTITIES}
 
     def _wpm_curves(self, points: pd.DataFrame) -> dict[str, np.ndarray]:
@@ -112,6 +116,21 @@ class Simulated:
             return dict(sim0)
         changed = self._model_curves(self.model.with_parameters(values), points)
         return {q: sim0[q] + changed[q] - model0[q] for q in QUANTITIES}
+
+    def predictor(self, points: pd.DataFrame) -> Callable[[dict], dict[str, np.ndarray]]:
+        """:meth:`predict` at fixed ``points``, their conditions read once where the model
+        is the simulation (a fit calls it hundreds of times)."""
+        if self.external or self.wheel_per_row:
+            return lambda values: self.predict(points, values)
+        conditions = _conditions(points)
+        return lambda values: self._curves_of(self.model.with_parameters(values or {}),
+                                              conditions)
+
+
+def _conditions(points: pd.DataFrame) -> tuple[np.ndarray, ...]:
+    """Load, slip, multipass and gravity of each point (``WheelModel.curves``'s inputs)."""
+    return tuple(points[c].to_numpy(float)
+                 for c in ("wheel_load_n", "slip", "multipass", "gravity_mps2"))
 
 
 def load_simulated(source: str | Path, reference: str | Path | None = None) -> Simulated:

@@ -133,7 +133,7 @@ class WheelModel:
             geo = effect.geometry(geo, soil, cond, self.wheel)
         contact_forces = _ContactForces(soil, geo, cond)
         z_max = np.full(cond.slip.shape, self.wheel.radius_m)
-        sinkage, residual = solve_increasing(lambda z: contact_forces(z)["fz_n"],
+        sinkage, residual = solve_increasing(contact_forces.fz_n,
                                              np.full_like(z_max, 1e-9 * self.wheel.radius_m),
                                              z_max, cond.load_n)
         out = contact_forces(sinkage)
@@ -190,8 +190,9 @@ class _ContactForces:
         slope = np.where(self.skid, soil.n_skid_slope, soil.n_slope)
         self.n = soil.n0 + slope * np.abs(cond.slip)
 
-    def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
-        soil, geo, b = self.soil, self.geo, self.width
+    def _stresses(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
+        """Contact angles, the Gauss grid and the stresses on it at a trial sinkage."""
+        soil, geo = self.soil, self.geo
         r_c = geo.contact_radius_m(sinkage_m)
         r_s = r_c + geo.shear_offset_m
         theta1 = np.arccos(np.clip(1.0 - sinkage_m / r_c, -1.0, 1.0))
@@ -204,27 +205,48 @@ class _ContactForces:
         (rear, w_rear), (front, w_front) = (stress.region_grid(theta2, thetam),
                                             stress.region_grid(thetam, theta1))
         theta = np.concatenate([rear, front], axis=-1)
-        weights = np.concatenate([w_rear, w_front], axis=-1)
-        sigma = stress.normal_stress(theta, theta1, theta2, thetam, self.k_reece, self.n, r_c, b)
+        sigma = stress.normal_stress(theta, theta1, theta2, thetam, self.k_reece, self.n, r_c,
+                                     self.width)
         j = self._shear_displacement(theta, theta1, thetat, r_s)
         tau = stress.shear_stress(sigma, j, soil.cohesion_pa, soil.phi_rad, soil.shear_modulus_m)
-        cos, sin = np.cos(theta), np.sin(theta)
-        integral = lambda f: np.sum(f * weights, axis=-1)  # noqa: E731
-        thrust = b * r_s * integral(tau * cos)
-        compaction = b * r_c * integral(sigma * sin)
-        j_exit = self._shear_displacement(theta2[..., None], theta1, thetat, r_s)[..., 0]
+        return {"r_c": r_c, "r_s": r_s, "theta1": theta1, "theta2": theta2, "thetat": thetat,
+                "thetam": thetam, "theta": theta, "sigma": sigma, "tau": tau,
+                "weights": np.concatenate([w_rear, w_front], axis=-1)}
+
+    @staticmethod
+    def _fz(st: dict[str, np.ndarray], width_m: float) -> np.ndarray:
+        integral = lambda f: np.sum(f * st["weights"], axis=-1)  # noqa: E731
+        return width_m * (st["r_c"] * integral(st["sigma"] * np.cos(st["theta"]))
+                          + st["r_s"] * integral(st["tau"] * np.sin(st["theta"])))
+
+    def fz_n(self, sinkage_m: np.ndarray) -> np.ndarray:
+        """The vertical soil force alone (what the sinkage solve needs)."""
+        return self._fz(self._stresses(sinkage_m), self.width)
+
+    def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
+        st, geo, b = self._stresses(sinkage_m), self.geo, self.width
+        r_c, r_s, tau, theta = st["r_c"], st["r_s"], st["tau"], st["theta"]
+        integral = lambda f: np.sum(f * st["weights"], axis=-1)  # noqa: E731
+        thrust = b * r_s * integral(tau * np.cos(theta))
+        compaction = b * r_c * integral(st["sigma"] * np.sin(theta))
+        j_exit = self._shear_displacement(st["theta2"][..., None], st["theta1"], st["thetat"],
+                                          r_s)[..., 0]
         return {
-            "fz_n": b * (r_c * integral(sigma * cos) + r_s * integral(tau * sin)),
+            "fz_n": self._fz(st, b),
             "dp_soil_n": thrust - compaction,
             "torque_soil_nm": (geo.arm_radius_m + geo.shear_offset_m) * b * r_s * integral(tau),
             "thrust_n": thrust, "compaction_resistance_n": compaction,
-            "theta1_rad": theta1, "theta2_rad": theta2, "thetam_rad": thetam,
+            "theta1_rad": st["theta1"], "theta2_rad": st["theta2"], "thetam_rad": st["thetam"],
             "exit_shear_displacement_m": j_exit,
         }
 
     def _shear_displacement(self, theta, theta1, thetat, r_s):
         """j (m): part I for driven, part II for braked or towed conditions."""
         slip = self.slip
-        driven = stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
+        if not self.skid.any():  # only the branch the conditions need (most campaigns: one)
+            return stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
         braked = stress.skid_shear_displacement(theta, theta1, thetat, r_s, np.minimum(slip, 0.0))
+        if self.skid.all():
+            return braked
+        driven = stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
         return np.where(self.skid[..., None], braked, driven)
