@@ -24,6 +24,7 @@ from campaign_report.figures import condition_text, gap_heatmap, slip_band_text,
 from campaign_report.html import Block, Heading, Image, Note, Page, Section, Table, render_page
 from campaign_report.images import to_png
 from swtlab.atomic import write_atomically
+from terramechanics.effects.depth_varying import SUFFIX as DEPTH_VARYING
 from terramechanics.effects.load_varying import SUFFIX as LOAD_VARYING
 from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, value_text
 from sim_gap.vocabulary import slip_band_labels
@@ -38,14 +39,22 @@ SOIL_ONLY = "soil_only"
 SOIL_ONLY_TEXT = "soil recalibration only"
 
 
+#: a generalised law's suffix in words
+VARYING_TEXT = {LOAD_VARYING: ", strength varying with load",
+                DEPTH_VARYING: ", resistance varying with rut depth"}
+_LAW_KEY = r"[a-z_]+?\d{4}(?:" + "|".join(map(re.escape, VARYING_TEXT)) + ")?"
+
+
 def law_text(law: str) -> str:
     """A law's key (``wong_kobayashi2012``) as its authors and year (Wong & Kobayashi 2012);
-    a load-varying law (``ding2011~load``) says so (Ding 2011, strength varying with load)."""
-    match = re.fullmatch(r"([a-z_]+?)(\d{4})(" + re.escape(LOAD_VARYING) + ")?", law)
+    a load- or depth-varying law (``ding2011~load``) says so (Ding 2011, strength varying
+    with load)."""
+    match = re.fullmatch(r"([a-z_]+?)(\d{4})(" + "|".join(map(re.escape, VARYING_TEXT))
+                         + ")?", law)
     if not match:
         return law
     text = " & ".join(n.capitalize() for n in match.group(1).split("_")) + " " + match.group(2)
-    return text + (", strength varying with load" if match.group(3) else "")
+    return text + VARYING_TEXT.get(match.group(3) or "", "")
 
 
 def _effect_text(part: str) -> str:
@@ -72,8 +81,7 @@ def words(text: str, labels: list[str]) -> str:
                     if "_" in n or "+" in n or "(" in n}, key=len, reverse=True)
     pattern = re.compile(r"(?<![\w+])(" + "|".join(map(re.escape, names)) + r")(?![\w+])")
     text = pattern.sub(lambda m: candidate_text(m.group(1)), text)
-    text = re.sub(r"\b[a-z_]+\d{4}(" + re.escape(LOAD_VARYING) + r")?\b",
-                  lambda m: law_text(m.group(0)), text)  # a law's key
+    text = re.sub(r"\b" + _LAW_KEY + r"\b", lambda m: law_text(m.group(0)), text)  # a law
     text = re.sub(r"\b(" + "|".join(q for q in QUANTITIES if "_" in q) + r")\b",
                   lambda m: QUANTITIES[m.group(1)].label, text)  # a quantity's column
     text = re.sub(r"(\d) SE\b", r"\1 standard errors", text)

@@ -77,6 +77,8 @@ PARAMETERS = {
                                                          "MPa/m", 1e-6),
     "effects.slip_sinkage.load_exponent": Quantity("a (load exponent of the strength)", "-"),
     "effects.wheel_flexibility.load_exponent": Quantity("a (load exponent of the strength)", "-"),
+    "effects.bulldozing.depth_exponent": Quantity("a (rut-depth exponent of the resistance)",
+                                                  "-"),
 }
 #: the effects of the built-in model (terramechanics.EFFECTS) in plain words
 EFFECTS = {"grousers": "grousers", "slip_sinkage": "slip sinkage",

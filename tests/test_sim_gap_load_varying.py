@@ -1,5 +1,6 @@
-"""Held out, one law per family is left: a load-varying law (``law~load``) stands in for the
-family's other law where the plain law cannot (bench/bench_law_mimic.py's ceiling, noise-free,
+"""Held out, one law per family is left: a load-varying law (``law~load``), or for bulldozing
+a depth-varying one (``law~depth``), stands in for the family's other law where the plain law
+cannot (bench/bench_law_mimic.py's ceiling, noise-free,
 on the blind bench's full design with the lugged and the smooth wheel). This checks the
 candidates' reach, in family (both laws are the project's); the blind bench checks the
 diagnosis."""
@@ -41,9 +42,29 @@ def test_a_load_varying_law_stands_in_for_its_sibling(tmp_path, family, truth, s
     assert values[f"effects.{family}.load_exponent"] != 0.0
 
 
-def test_load_varying_laws_need_three_loads():
-    """At one or two set loads a load exponent only restates the strength: not a candidate,
-    unless it is all an effect was given."""
+def test_a_depth_varying_rankine_law_stands_in_for_bekkers_bulldozing(tmp_path):
+    """Bekker's bulldozing at 90 % of the bench's range is 16 times Rankine's formula and
+    grows about as z^1.7 on these ruts: Rankine's published law, bounded at 5, leaves 6
+    sigma; its depth form (coefficient to 20, a depth exponent) well under the bound."""
+    path = tmp_path / "points.csv"
+    write_points(truth_model("bulldozing", "bekker1969", 0.9), path)
+    points = from_points_csv(path)
+    base = base_model()
+    sim = Simulated(base, wheel_per_row=True)
+    sigma = sigmas(points, sim.radius_m)
+    plain, _ = held_out_rms(base, ("bulldozing",), {"bulldozing": "rankine_terzaghi1943"},
+                            points, sim, sigma)
+    varying, values = held_out_rms(base, ("bulldozing",),
+                                   {"bulldozing": "rankine_terzaghi1943~depth"}, points, sim,
+                                   sigma)
+    assert plain > 2 * BOUND_SIGMA and varying < 0.5 * BOUND_SIGMA
+    assert -1.0 < values["effects.bulldozing.depth_exponent"] < 0.0
+    assert values["effects.bulldozing.coefficient"] > 5.0
+
+
+def test_generalised_laws_need_three_loads():
+    """At one or two set loads a load (or rut-depth) exponent only restates the strength:
+    not a candidate, unless it is all an effect was given."""
     import terramechanics as tm
     from sim_gap.candidates import allowed_laws, for_loads
 
@@ -53,6 +74,7 @@ def test_load_varying_laws_need_three_loads():
     fewer = for_loads(every, 2)
     assert fewer["slip_sinkage"] == ("ding2011", "lyasko2010")
     assert fewer["wheel_flexibility"] == tuple(tm.PUBLISHED_LAWS["wheel_flexibility"])
-    assert fewer["bulldozing"] == every["bulldozing"]
+    assert fewer["bulldozing"] == tuple(tm.PUBLISHED_LAWS["bulldozing"])
+    assert "rankine_terzaghi1943~depth" in every["bulldozing"]
     only = {"slip_sinkage": ("ding2011~load",)}
     assert for_loads(only, 1) == only

@@ -181,6 +181,30 @@ def test_rankine_bulldozing_hand_calculation():
     assert model.curves(180.0, 0.3)["dp_n"] - on["dp_n"] == pytest.approx(hand, rel=1e-9)
 
 
+def test_depth_varying_bulldozing_by_hand():
+    """``rankine_terzaghi1943~depth``: Rankine's passive force times the coefficient and
+    (z / 10 mm)^a at the solved sinkage (bulldozing leaves the sinkage alone); a = 0 is the
+    published law; its coefficient may go to 20, the published law's to 5."""
+    model = tm.WheelModel(tm.Wheel(0.125, 0.112), tm.LETE_SAND)
+    law = "rankine_terzaghi1943"
+    varying = LAWS["bulldozing"][law + "~depth"]
+    assert varying.relaxes == law and tm.published_law("bulldozing", varying.law) == law
+    assert {p.name: p.upper for p in varying.fit} == {"coefficient": 20.0,
+                                                      "depth_exponent": 1.5}
+    loads = np.array([60.0, 180.0, 300.0])
+    on = model.with_effects(bulldozing={"law": varying.law, "coefficient": 8.0,
+                                        "depth_exponent": -0.4}).curves(loads, 0.3)
+    flat = model.with_effects(bulldozing={"law": varying.law, "coefficient": 3.0}).curves(
+        loads, 0.3)
+    published = model.with_effects(bulldozing={"law": law, "coefficient": 3.0}).curves(loads, 0.3)
+    z, phi = on["sinkage_m"], np.radians(31.1)
+    n_phi = np.tan(np.radians(45) + phi / 2) ** 2
+    rankine = 0.112 * (0.5 * 1600 * 9.80665 * z**2 * n_phi + 2 * 1300 * z * np.sqrt(n_phi))
+    assert on["bulldozing_n"] == pytest.approx(8.0 * (z / 0.01) ** -0.4 * rankine, rel=1e-12)
+    assert on["sinkage_m"] == pytest.approx(model.curves(loads, 0.3)["sinkage_m"], rel=1e-12)
+    assert flat["bulldozing_n"] == pytest.approx(published["bulldozing_n"], rel=1e-12)
+
+
 def test_bekker_bulldozing_is_17_to_180_times_rankines_on_planetary_ruts():
     # the ratio the Rankine module's docstring quotes for its fit range
     from terramechanics.effects.bulldozing_bekker1969 import bulldozing_resistance_n

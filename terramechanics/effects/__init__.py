@@ -14,6 +14,7 @@ from terramechanics.effects.bulldozing_bekker1969 import BulldozingBekker1969
 from terramechanics.effects.bulldozing_rankine_terzaghi1943 import BulldozingRankineTerzaghi1943
 from terramechanics.effects.grousers_bekker1956 import GrousersBekker1956
 from terramechanics.effects.grousers_ding2011 import GrousersDing2011
+from terramechanics.effects.depth_varying import COEFFICIENT_UPPER, depth_varying
 from terramechanics.effects.load_varying import STRENGTH, load_varying
 from terramechanics.effects.multipass_krenn_hirzinger2009 import MultipassKrennHirzinger2009
 from terramechanics.effects.multipass_wong2010 import MultipassWong2010
@@ -37,10 +38,14 @@ for _cls in _ALL:
     PUBLISHED_LAWS.setdefault(_cls.name, {})[_cls.law] = _cls
 
 #: effect -> law -> class: the published laws and, for the effects of
-#: ``load_varying.STRENGTH``, each with its strength varying with the load (``law~load``)
+#: ``load_varying.STRENGTH``, each with its strength varying with the load (``law~load``),
+#: for those of ``depth_varying.COEFFICIENT_UPPER`` with the rut depth (``law~depth``)
 LAWS: dict[str, dict[str, type[Effect]]] = {e: dict(laws) for e, laws in PUBLISHED_LAWS.items()}
 for (_name, _law), _strength in STRENGTH.items():
     _varying = load_varying(PUBLISHED_LAWS[_name][_law], _strength)
+    LAWS[_name][_varying.law] = _varying
+for (_name, _law), _upper in COEFFICIENT_UPPER.items():
+    _varying = depth_varying(PUBLISHED_LAWS[_name][_law], _upper)
     LAWS[_name][_varying.law] = _varying
 
 
