@@ -42,15 +42,14 @@ SOIL_ONLY_TEXT = "soil recalibration only"
 #: a generalised law's suffix in words
 VARYING_TEXT = {LOAD_VARYING: ", strength varying with load",
                 DEPTH_VARYING: ", resistance varying with rut depth"}
-_LAW_KEY = r"[a-z_]+?\d{4}(?:" + "|".join(map(re.escape, VARYING_TEXT)) + ")?"
+_SUFFIX = "(" + "|".join(map(re.escape, VARYING_TEXT)) + ")?"
 
 
 def law_text(law: str) -> str:
     """A law's key (``wong_kobayashi2012``) as its authors and year (Wong & Kobayashi 2012);
     a load- or depth-varying law (``ding2011~load``) says so (Ding 2011, strength varying
     with load)."""
-    match = re.fullmatch(r"([a-z_]+?)(\d{4})(" + "|".join(map(re.escape, VARYING_TEXT))
-                         + ")?", law)
+    match = re.fullmatch(r"([a-z_]+?)(\d{4})" + _SUFFIX, law)
     if not match:
         return law
     text = " & ".join(n.capitalize() for n in match.group(1).split("_")) + " " + match.group(2)
@@ -81,7 +80,8 @@ def words(text: str, labels: list[str]) -> str:
                     if "_" in n or "+" in n or "(" in n}, key=len, reverse=True)
     pattern = re.compile(r"(?<![\w+])(" + "|".join(map(re.escape, names)) + r")(?![\w+])")
     text = pattern.sub(lambda m: candidate_text(m.group(1)), text)
-    text = re.sub(r"\b" + _LAW_KEY + r"\b", lambda m: law_text(m.group(0)), text)  # a law
+    text = re.sub(r"\b[a-z_]+?\d{4}" + _SUFFIX + r"\b", lambda m: law_text(m.group(0)),
+                  text)  # a law's key
     text = re.sub(r"\b(" + "|".join(q for q in QUANTITIES if "_" in q) + r")\b",
                   lambda m: QUANTITIES[m.group(1)].label, text)  # a quantity's column
     text = re.sub(r"(\d) SE\b", r"\1 standard errors", text)

@@ -215,9 +215,8 @@ class _ContactForces:
 
     @staticmethod
     def _fz(st: dict[str, np.ndarray], width_m: float) -> np.ndarray:
-        integral = lambda f: np.sum(f * st["weights"], axis=-1)  # noqa: E731
-        return width_m * (st["r_c"] * integral(st["sigma"] * np.cos(st["theta"]))
-                          + st["r_s"] * integral(st["tau"] * np.sin(st["theta"])))
+        return width_m * (st["r_c"] * _integral(st["sigma"] * np.cos(st["theta"]), st)
+                          + st["r_s"] * _integral(st["tau"] * np.sin(st["theta"]), st))
 
     def fz_n(self, sinkage_m: np.ndarray) -> np.ndarray:
         """The vertical soil force alone (what the sinkage solve needs)."""
@@ -226,15 +225,15 @@ class _ContactForces:
     def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
         st, geo, b = self._stresses(sinkage_m), self.geo, self.width
         r_c, r_s, tau, theta = st["r_c"], st["r_s"], st["tau"], st["theta"]
-        integral = lambda f: np.sum(f * st["weights"], axis=-1)  # noqa: E731
-        thrust = b * r_s * integral(tau * np.cos(theta))
-        compaction = b * r_c * integral(st["sigma"] * np.sin(theta))
+        thrust = b * r_s * _integral(tau * np.cos(theta), st)
+        compaction = b * r_c * _integral(st["sigma"] * np.sin(theta), st)
         j_exit = self._shear_displacement(st["theta2"][..., None], st["theta1"], st["thetat"],
                                           r_s)[..., 0]
         return {
             "fz_n": self._fz(st, b),
             "dp_soil_n": thrust - compaction,
-            "torque_soil_nm": (geo.arm_radius_m + geo.shear_offset_m) * b * r_s * integral(tau),
+            "torque_soil_nm": ((geo.arm_radius_m + geo.shear_offset_m) * b * r_s
+                               * _integral(tau, st)),
             "thrust_n": thrust, "compaction_resistance_n": compaction,
             "theta1_rad": st["theta1"], "theta2_rad": st["theta2"], "thetam_rad": st["thetam"],
             "exit_shear_displacement_m": j_exit,
@@ -250,3 +249,8 @@ class _ContactForces:
             return braked
         driven = stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
         return np.where(self.skid[..., None], braked, driven)
+
+
+def _integral(f: np.ndarray, st: dict[str, np.ndarray]) -> np.ndarray:
+    """Gauss quadrature of ``f`` over the contact (the grid of ``_ContactForces._stresses``)."""
+    return np.sum(f * st["weights"], axis=-1)

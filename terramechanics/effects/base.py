@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import ClassVar
 
 from terramechanics.state import Condition, Contact, ExtraForces, Geometry, SoilState
@@ -47,3 +47,9 @@ class Effect:
     def forces(self, contact: Contact, soil: SoilState, geo: Geometry, cond: Condition,
                wheel: Wheel) -> ExtraForces:
         return ExtraForces()
+
+
+def published_with(effect: Effect, cls: type[Effect], name: str, value) -> Effect:
+    """The published law ``cls`` with ``effect``'s values of its fields and ``name`` set to
+    ``value`` (an array: one per condition): how a generalised law acts."""
+    return cls(**{**{f.name: getattr(effect, f.name) for f in fields(cls)}, name: value})

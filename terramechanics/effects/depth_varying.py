@@ -22,11 +22,11 @@ measures how far each law's depth form comes to the other law's truths.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from terramechanics.effects.base import Effect, FitParam
+from terramechanics.effects.base import Effect, FitParam, published_with
 
 #: the rut depth at which a depth-varying law's coefficient is its published one (m)
 REFERENCE_DEPTH_M = 0.01
@@ -57,10 +57,9 @@ def depth_varying(cls: type[Effect], coefficient_upper: float) -> type[Effect]:
 
         def forces(self, contact, soil, geo, cond, wheel):
             depth = np.maximum(np.asarray(contact.sinkage_m, float), 1e-12)
-            values = {f.name: getattr(self, f.name) for f in fields(cls)}
-            values["coefficient"] = (self.coefficient
-                                     * (depth / REFERENCE_DEPTH_M) ** self.depth_exponent)
-            return cls(**values).forces(contact, soil, geo, cond, wheel)
+            scale = (depth / REFERENCE_DEPTH_M) ** self.depth_exponent
+            return published_with(self, cls, "coefficient", self.coefficient * scale).forces(
+                contact, soil, geo, cond, wheel)
 
     DepthVarying.__name__ = DepthVarying.__qualname__ = cls.__name__ + "DepthVarying"
     DepthVarying.__doc__ = (f"{cls.__name__} with its coefficient times (z / "

@@ -20,11 +20,11 @@ in the same bench: bulldozing's coefficient is bounded, the lug laws differ in s
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
-from terramechanics.effects.base import Effect, FitParam
+from terramechanics.effects.base import Effect, FitParam, published_with
 
 #: the load at which a load-varying law's strength is its published parameter (N)
 REFERENCE_LOAD_N = 100.0
@@ -53,8 +53,7 @@ def load_varying(cls: type[Effect], strength: str) -> type[Effect]:
         def at(self, cond) -> Effect:
             """The published law with this law's strength at each condition's load."""
             scale = (np.asarray(cond.load_n, float) / REFERENCE_LOAD_N) ** self.load_exponent
-            values = {f.name: getattr(self, f.name) for f in fields(cls)}
-            return cls(**{**values, strength: values[strength] * scale})
+            return published_with(self, cls, strength, getattr(self, strength) * scale)
 
         def soil(self, soil, cond, wheel):
             return self.at(cond).soil(soil, cond, wheel)
