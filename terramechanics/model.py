@@ -124,7 +124,8 @@ class WheelModel:
             raise ValueError("load_n must be > 0")
         if np.any(arrays[1] < -1):
             raise ValueError("slip must be >= -1 (a locked wheel)")
-        cond = Condition(*(a.copy() for a in arrays))
+        shape = arrays[0].shape
+        cond = Condition(*(a.ravel().copy() for a in arrays))  # flat: the solve picks elements
         soil, geo = self._soil_state(cond), self._base_geometry(cond)
         for name in SOIL_ORDER:
             if name in self.effects:
@@ -132,10 +133,9 @@ class WheelModel:
         for effect in self.effects.values():  # geometry sees the soil all effects made
             geo = effect.geometry(geo, soil, cond, self.wheel)
         contact_forces = _ContactForces(soil, geo, cond)
-        z_max = np.full(cond.slip.shape, self.wheel.radius_m)
         sinkage, residual = solve_increasing(contact_forces.fz_n,
-                                             np.full_like(z_max, 1e-9 * self.wheel.radius_m),
-                                             z_max, cond.load_n)
+                                             np.full(cond.slip.shape, self.wheel.radius_m),
+                                             cond.load_n, contact_forces.n + 0.5)
         out = contact_forces(sinkage)
         contact = Contact(sinkage, out["theta1_rad"], out["theta2_rad"], out["thetam_rad"],
                           out.pop("exit_shear_displacement_m"))
@@ -146,7 +146,7 @@ class WheelModel:
             extra = effect.forces(contact, soil, geo, cond, self.wheel)
             dp, torque = dp + extra.dp_n, torque + extra.torque_nm
             terms.update(extra.terms)
-        return {
+        result = {
             "load_n": cond.load_n, "slip": cond.slip, "multipass": cond.multipass,
             "gravity_mps2": cond.gravity_mps2, "dp_n": dp, "torque_nm": torque,
             "sinkage_m": sinkage, "resistance_n": torque / self.wheel.radius_m - dp,
@@ -157,6 +157,7 @@ class WheelModel:
             "theta1_rad": out["theta1_rad"], "theta2_rad": out["theta2_rad"],
             "thetam_rad": out["thetam_rad"], **terms,
         }
+        return {name: np.reshape(values, shape) for name, values in result.items()}
 
     def _soil_state(self, cond: Condition) -> SoilState:
         s, shape = self.soil, cond.slip.shape
@@ -181,7 +182,7 @@ class _ContactForces:
 
     def __init__(self, soil: SoilState, geo: Geometry, cond: Condition) -> None:
         b = geo.width_m
-        self.soil, self.geo, self.width = soil, geo, b
+        self.soil, self.geo, self.cond, self.width = soil, geo, cond, b
         self.k_reece = (soil.kc / b + soil.kphi) * b ** soil.n0
         self.slip = cond.slip
         self.skid = cond.slip < 0
@@ -205,30 +206,35 @@ class _ContactForces:
         (rear, w_rear), (front, w_front) = (stress.region_grid(theta2, thetam),
                                             stress.region_grid(thetam, theta1))
         theta = np.concatenate([rear, front], axis=-1)
-        sigma = stress.normal_stress(theta, theta1, theta2, thetam, self.k_reece, self.n, r_c,
-                                     self.width)
-        j = self._shear_displacement(theta, theta1, thetat, r_s)
+        cos_theta, sin_theta = np.cos(theta), np.sin(theta)
+        sigma = stress.normal_stress(rear, cos_theta[..., rear.shape[-1]:], theta1, theta2,
+                                     thetam, self.k_reece, self.n, r_c, self.width)
+        j = self._shear_displacement(theta, sin_theta, theta1, thetat, r_s)
         tau = stress.shear_stress(sigma, j, soil.cohesion_pa, soil.phi_rad, soil.shear_modulus_m)
         return {"r_c": r_c, "r_s": r_s, "theta1": theta1, "theta2": theta2, "thetat": thetat,
-                "thetam": thetam, "theta": theta, "sigma": sigma, "tau": tau,
-                "weights": np.concatenate([w_rear, w_front], axis=-1)}
+                "thetam": thetam, "theta": theta, "cos_theta": cos_theta, "sin_theta": sin_theta,
+                "sigma": sigma, "tau": tau, "weights": np.concatenate([w_rear, w_front], axis=-1)}
 
     @staticmethod
     def _fz(st: dict[str, np.ndarray], width_m: float) -> np.ndarray:
-        return width_m * (st["r_c"] * _integral(st["sigma"] * np.cos(st["theta"]), st)
-                          + st["r_s"] * _integral(st["tau"] * np.sin(st["theta"]), st))
+        return width_m * (st["r_c"] * _integral(st["sigma"] * st["cos_theta"], st)
+                          + st["r_s"] * _integral(st["tau"] * st["sin_theta"], st))
 
-    def fz_n(self, sinkage_m: np.ndarray) -> np.ndarray:
-        """The vertical soil force alone (what the sinkage solve needs)."""
-        return self._fz(self._stresses(sinkage_m), self.width)
+    def fz_n(self, sinkage_m: np.ndarray, at: np.ndarray | None = None) -> np.ndarray:
+        """The vertical soil force alone (what the sinkage solve needs), at the conditions
+        ``at`` (indices; None: all)."""
+        forces = self if at is None else _ContactForces(
+            *(_elements(state, at) for state in (self.soil, self.geo, self.cond)))
+        return forces._fz(forces._stresses(sinkage_m), forces.width)
 
     def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
         st, geo, b = self._stresses(sinkage_m), self.geo, self.width
-        r_c, r_s, tau, theta = st["r_c"], st["r_s"], st["tau"], st["theta"]
-        thrust = b * r_s * _integral(tau * np.cos(theta), st)
-        compaction = b * r_c * _integral(st["sigma"] * np.sin(theta), st)
-        j_exit = self._shear_displacement(st["theta2"][..., None], st["theta1"], st["thetat"],
-                                          r_s)[..., 0]
+        r_c, r_s, tau = st["r_c"], st["r_s"], st["tau"]
+        thrust = b * r_s * _integral(tau * st["cos_theta"], st)
+        compaction = b * r_c * _integral(st["sigma"] * st["sin_theta"], st)
+        exit_angle = st["theta2"][..., None]
+        j_exit = self._shear_displacement(exit_angle, np.sin(exit_angle), st["theta1"],
+                                          st["thetat"], r_s)[..., 0]
         return {
             "fz_n": self._fz(st, b),
             "dp_soil_n": thrust - compaction,
@@ -239,16 +245,24 @@ class _ContactForces:
             "exit_shear_displacement_m": j_exit,
         }
 
-    def _shear_displacement(self, theta, theta1, thetat, r_s):
+    def _shear_displacement(self, theta, sin_theta, theta1, thetat, r_s):
         """j (m): part I for driven, part II for braked or towed conditions."""
         slip = self.slip
         if not self.skid.any():  # only the branch the conditions need (most campaigns: one)
-            return stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
-        braked = stress.skid_shear_displacement(theta, theta1, thetat, r_s, np.minimum(slip, 0.0))
+            return stress.shear_displacement(theta, sin_theta, theta1, r_s,
+                                             np.maximum(slip, 0.0))
+        braked = stress.skid_shear_displacement(theta, sin_theta, theta1, thetat, r_s,
+                                                np.minimum(slip, 0.0))
         if self.skid.all():
             return braked
-        driven = stress.shear_displacement(theta, theta1, r_s, np.maximum(slip, 0.0))
+        driven = stress.shear_displacement(theta, sin_theta, theta1, r_s, np.maximum(slip, 0.0))
         return np.where(self.skid[..., None], braked, driven)
+
+
+def _elements(state, at: np.ndarray):
+    """``state`` (a dataclass of per-condition arrays, 1-D) at the conditions ``at``."""
+    return replace(state, **{f.name: value[at] for f in dataclasses.fields(state)
+                             if np.ndim(value := getattr(state, f.name)) == 1})
 
 
 def _integral(f: np.ndarray, st: dict[str, np.ndarray]) -> np.ndarray:

@@ -66,32 +66,36 @@ def region_grid(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return lo[..., None] + span * NODES, span * WEIGHTS
 
 
-def normal_stress(theta, theta1, theta2, thetam, k_reece_pa, n, radius_m, width_m):
-    """Wong-Reece normal stress (Pa); ``k_reece_pa = (kc/b + kphi) b^n0``."""
+def normal_stress(rear, cos_front, theta1, theta2, thetam, k_reece_pa, n, radius_m, width_m):
+    """Wong-Reece normal stress (Pa) on the rear grid ``rear`` (angles in [theta_2,
+    theta_m]) and the front grid (given by its cosines), joined rear first;
+    ``k_reece_pa = (kc/b + kphi) b^n0``."""
     t1, t2, tm = theta1[..., None], theta2[..., None], thetam[..., None]
-    rear = theta < tm
     span = np.where(tm - t2 > 0, tm - t2, 1.0)
-    equiv = np.where(rear, t1 - (theta - t2) / span * (t1 - tm), theta)
-    depth = np.maximum(radius_m[..., None] * (np.cos(equiv) - np.cos(t1)), 0.0)
+    equiv = t1 - (rear - t2) / span * (t1 - tm)
+    cos_t1 = np.cos(t1)
+    depth = np.maximum(radius_m[..., None]
+                       * (np.concatenate([np.cos(equiv), cos_front], axis=-1) - cos_t1), 0.0)
     return k_reece_pa[..., None] * (depth / width_m) ** n[..., None]
 
 
-def shear_displacement(theta, theta1, shear_radius_m, slip):
-    """Shear displacement j (m) of a driven wheel, slip in [0, 1] (Wong & Reece 1967, part I)."""
+def shear_displacement(theta, sin_theta, theta1, shear_radius_m, slip):
+    """Shear displacement j (m) of a driven wheel, slip in [0, 1] (Wong & Reece 1967, part I);
+    ``sin_theta``: the sines of the angles ``theta``."""
     t1 = theta1[..., None]
     return shear_radius_m[..., None] * ((t1 - theta) - (1.0 - slip)[..., None]
-                                        * (np.sin(t1) - np.sin(theta)))
+                                        * (np.sin(t1) - sin_theta))
 
 
-def skid_shear_displacement(theta, theta1, thetat, shear_radius_m, slip):
+def skid_shear_displacement(theta, sin_theta, theta1, thetat, shear_radius_m, slip):
     """Shear displacement j (m) of a braked or towed wheel, skid in [-1, 0) (Wong & Reece
     1967, part II): flow zone in front of ``thetat``, reversed shear behind it; +-inf for a
     locked wheel (0 where the bracket vanishes, at theta_t and theta_1)."""
     t1, tt = theta1[..., None], thetat[..., None]
     rolling = (1.0 + slip)[..., None]
     chord = (np.sin(t1) - np.sin(tt)) / np.where(t1 > tt, t1 - tt, 1.0)
-    shape = np.where(theta > tt, (t1 - theta) * chord - (np.sin(t1) - np.sin(theta)),
-                     rolling * (tt - theta) - (np.sin(tt) - np.sin(theta)))
+    shape = np.where(theta > tt, (t1 - theta) * chord - (np.sin(t1) - sin_theta),
+                     rolling * (tt - theta) - (np.sin(tt) - sin_theta))
     with np.errstate(divide="ignore", invalid="ignore"):
         j = shear_radius_m[..., None] * shape / rolling
     return np.where(shape == 0, 0.0, j)
