@@ -135,7 +135,7 @@ class WheelModel:
         contact_forces = _ContactForces(soil, geo, cond)
         sinkage, residual = solve_increasing(contact_forces.fz_n,
                                              np.full(cond.slip.shape, self.wheel.radius_m),
-                                             cond.load_n, contact_forces.n + 0.5)
+                                             cond.load_n, np.maximum(contact_forces.n, 0.0) + 0.5)
         out = contact_forces(sinkage)
         contact = Contact(sinkage, out["theta1_rad"], out["theta2_rad"], out["thetam_rad"],
                           out.pop("exit_shear_displacement_m"))
