@@ -1,7 +1,8 @@
 """Time of one gap diagnosis (sim_gap.diagnose) of a 100-run campaign with all six candidate
-effects under every law of each (19 singles, 75 pairs on the one-law-at-a-time design; 0.10,
-without the depth-varying bulldozing laws, 17 and 65; until 0.10.0, without the load-varying
-laws, 13 and 45):
+effects under every law of each (20 singles, 80 pairs on the one-law-at-a-time design;
+0.11-0.12, without Bekker's lugs with slip-sinkage, 19 and 75; 0.10, without the
+depth-varying bulldozing laws, 17 and 65; until 0.10.0, without the load-varying laws, 13
+and 45):
 5 loads x 5 slips x multipass {0, 1} x gravity {g0, Mars}, measured values from the model
 with a hidden slip-sinkage + bulldozing pair and 0.5 %-of-load noise. Goal: under 60 s on
 two cores (``jobs=2``); the CPU seconds of the fits are printed too (wall time on a shared

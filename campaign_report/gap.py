@@ -26,6 +26,7 @@ from campaign_report.images import to_png
 from swtlab.atomic import write_atomically
 from terramechanics.effects.depth_varying import SUFFIX as DEPTH_VARYING
 from terramechanics.effects.load_varying import SUFFIX as LOAD_VARYING
+from terramechanics.effects.lug_slip_sinkage import SUFFIX as LUG_SLIP_SINKAGE
 from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, value_text
 from sim_gap.vocabulary import slip_band_labels
 from traceability.models import GapReport
@@ -41,14 +42,14 @@ SOIL_ONLY_TEXT = "soil recalibration only"
 
 #: a generalised law's suffix in words
 VARYING_TEXT = {LOAD_VARYING: ", strength varying with load",
-                DEPTH_VARYING: ", resistance varying with rut depth"}
+                DEPTH_VARYING: ", resistance varying with rut depth",
+                LUG_SLIP_SINKAGE: ", with the lugs' slip-sinkage"}
 _SUFFIX = "(" + "|".join(map(re.escape, VARYING_TEXT)) + ")?"
 
 
 def law_text(law: str) -> str:
     """A law's key (``wong_kobayashi2012``) as its authors and year (Wong & Kobayashi 2012);
-    a load- or depth-varying law (``ding2011~load``) says so (Ding 2011, strength varying
-    with load)."""
+    a generalised law (``ding2011~load``) says so (Ding 2011, strength varying with load)."""
     match = re.fullmatch(r"([a-z_]+?)(\d{4})" + _SUFFIX, law)
     if not match:
         return law

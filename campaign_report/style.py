@@ -69,6 +69,8 @@ PARAMETERS = {
     "effects.bulldozing.coefficient": Quantity("bulldozing factor (1 = the law as published)",
                                                "-"),
     "effects.grousers.lug_sinkage_gain": Quantity("κ (lug-induced sinkage gain)", "-"),
+    "effects.grousers.lug_slip_gain": Quantity("g (lugs' slip-sinkage: Lyasko's factor^(g h/r))",
+                                               "-"),
     "effects.slip_sinkage.coefficient": Quantity("κ (exponent on Lyasko's slip-sinkage factor)",
                                                  "-"),
     "effects.wheel_flexibility.ground_pressure_pa": Quantity("p_g (wheel ground pressure)", "kPa",

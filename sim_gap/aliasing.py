@@ -21,6 +21,7 @@ import pandas as pd
 
 import terramechanics as tm
 from sim_gap.points_csv import WHEEL_KEY
+from terramechanics.effects.slip_sinkage_lyasko2010 import slip_sinkage_coefficient
 
 #: the run that lifts the aliasing (the gap report's "test that would decide")
 SEPARATING_RUN = ("a smooth wheel (or one with other lugs) run on the same soil at the same "
@@ -28,6 +29,8 @@ SEPARATING_RUN = ("a smooth wheel (or one with other lugs) run on the same soil 
 #: a lug slip-sinkage that changes the sinkage exponent by less than this at the
 #: campaign's largest slip is negligible (a 1 % pressure change at z/b = 0.4)
 NEGLIGIBLE_EXPONENT_CHANGE = 0.01
+#: a lug slip-sinkage that multiplies the sinkage by less than 1 + this there is negligible
+NEGLIGIBLE_SINKAGE_CHANGE = 0.01
 
 
 def grouser_geometries(points: pd.DataFrame, wheel) -> set[tuple[int, float]]:
@@ -39,14 +42,24 @@ def grouser_geometries(points: pd.DataFrame, wheel) -> set[tuple[int, float]]:
     return {(int(wheel.grouser_count), float(wheel.grouser_height_m))}
 
 
-def lug_exponent_change(law: str, values: dict[str, float], wheel, max_slip: float) -> float:
-    """The change of the sinkage exponent that ``law`` of grousers, with the fitted
-    ``values``, makes at ``max_slip`` (0 for a law without a lug slip-sinkage term)."""
+def lug_slip_sinkage(law: str, values: dict[str, float], wheel, max_slip: float) -> str | None:
+    """What the lug slip-sinkage of ``law`` of grousers, with the fitted ``values``, does at
+    ``max_slip``, in words; None for a law without that term or where it is negligible.
+    Ding et al.'s lugs raise the sinkage exponent by ``kappa h/r s``; a ``~slip`` law
+    multiplies the sinkage by Lyasko's ``K_s^(g h/r)`` (terramechanics.effects.lug_slip_sinkage)."""
     effect = tm.law_class("grousers", law)()
-    if not hasattr(effect, "lug_sinkage_gain"):
-        return 0.0
-    gain = values.get("effects.grousers.lug_sinkage_gain", effect.lug_sinkage_gain)
-    return float(gain * wheel.grouser_height_m / wheel.radius_m * max_slip)
+    height_ratio = wheel.grouser_height_m / wheel.radius_m
+    if hasattr(effect, "lug_sinkage_gain"):
+        gain = values.get("effects.grousers.lug_sinkage_gain", effect.lug_sinkage_gain)
+        change = gain * height_ratio * max_slip
+        if change >= NEGLIGIBLE_EXPONENT_CHANGE:
+            return f"the exponent grows by {change:.2f} at slip {max_slip:.2f}"
+    if hasattr(effect, "lug_slip_gain"):
+        gain = values.get("effects.grousers.lug_slip_gain", effect.lug_slip_gain)
+        factor = float(slip_sinkage_coefficient(max_slip) ** (gain * height_ratio))
+        if factor - 1 >= NEGLIGIBLE_SINKAGE_CHANGE:
+            return f"the sinkage grows {factor:.2f} times at slip {max_slip:.2f}"
+    return None
 
 
 def aliasing_problem(points: pd.DataFrame, wheel, effects: list[str],
@@ -67,9 +80,8 @@ def aliasing_problem(points: pd.DataFrame, wheel, effects: list[str],
                 f"sink more as slip rises, Ding et al. 2011){fix}")
     if "grousers" in effects:
         max_slip = float(np.nanmax(np.abs(points["slip"].to_numpy(float))))
-        change = lug_exponent_change(laws["grousers"], values, wheel, max_slip)
-        if change >= NEGLIGIBLE_EXPONENT_CHANGE:
-            return (f"{where} the grousers call rests on their slip-sinkage term (the "
-                    f"exponent grows by {change:.2f} at slip {max_slip:.2f}), which the soil's "
-                    f"own slip-sinkage would give as well{fix}")
+        lugs = lug_slip_sinkage(laws["grousers"], values, wheel, max_slip)
+        if lugs is not None:
+            return (f"{where} the grousers call rests on their slip-sinkage term ({lugs}), "
+                    f"which the soil's own slip-sinkage would give as well{fix}")
     return None

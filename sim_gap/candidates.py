@@ -100,16 +100,17 @@ def allowed_laws(model: tm.WheelModel, effects: list[str],
     return out
 
 
-#: set loads a generalised law (``law~load``, ``law~depth``) needs: two fix its exponent, a
-#: third tests it (the rut depth follows the load most)
+#: set loads a generalised law (``law~load``, ``law~depth``, ``law~slip``) needs: two fix a
+#: load or depth exponent, a third tests it (the rut depth follows the load most); with
+#: fewer, few conditions, the candidates keep to the published laws
 MIN_LOADS_FOR_GENERALISED_LAWS = 3
 
 
 def for_loads(allowed: dict[str, tuple[str, ...]], n_loads: int) -> dict[str, tuple[str, ...]]:
-    """``allowed`` without the generalised laws (load- or depth-varying) where the points
-    have fewer than :data:`MIN_LOADS_FOR_GENERALISED_LAWS` set loads (their exponent would only
-    restate the published law's strength at the loads there are), unless they are all an
-    effect has."""
+    """``allowed`` without the generalised laws (load- or depth-varying, lugs with
+    slip-sinkage) where the points have fewer than :data:`MIN_LOADS_FOR_GENERALISED_LAWS` set
+    loads (an exponent would only restate the published law's strength at the loads there
+    are), unless they are all an effect has."""
     if n_loads >= MIN_LOADS_FOR_GENERALISED_LAWS:
         return allowed
     return {e: tuple(law for law in laws if tm.law_class(e, law).relaxes is None) or laws

@@ -197,6 +197,9 @@ def test_plain_words_and_display_units():
     # candidates with their laws, effect sets and law keys in a law-dependent reason
     assert candidate_text("grousers(ding2011)+reduced_gravity(wong_kobayashi2012)") == (
         "grousers (Ding 2011) + reduced gravity (Wong & Kobayashi 2012)")
+    assert candidate_text("grousers(bekker1956~slip)+bulldozing(rankine_terzaghi1943~depth)") == (
+        "grousers (Bekker 1956, with the lugs' slip-sinkage) + bulldozing (Rankine & Terzaghi "
+        "1943, resistance varying with rut depth)")
     keys = ["slip_sinkage(ding2011)", "grousers(ding2011)+slip_sinkage(lyasko2010)"]
     assert plain("under the best-fitting laws the verdict is slip_sinkage (slip_sinkage"
                  "(ding2011)), but with slip_sinkage under lyasko2010 it is grousers+slip_sinkage "

@@ -48,4 +48,11 @@ def test_grousers_call_is_aliased_only_when_it_rests_on_lug_sinkage():
     assert aliasing_problem(p, LUGGED, ["grousers"], {"grousers": "ding2011"},
                             {"effects.grousers.lug_sinkage_gain": 0.2}) is None
     assert aliasing_problem(p, LUGGED, ["grousers"], {"grousers": "bekker1956"}, {}) is None
+    # Bekker's law with the lugs' slip-sinkage of Lyasko's form: K_s(0.6)^(2 * 0.01/0.15)
+    # = 2.3^0.133 = 1.12; at a gain of 0.1 it is 1.006, negligible
+    reason = aliasing_problem(p, LUGGED, ["grousers"], {"grousers": "bekker1956~slip"},
+                              {"effects.grousers.lug_slip_gain": 2.0})
+    assert "sinkage grows 1.12 times at slip 0.60" in reason
+    assert aliasing_problem(p, LUGGED, ["grousers"], {"grousers": "bekker1956~slip"},
+                            {"effects.grousers.lug_slip_gain": 0.1}) is None
     assert aliasing_problem(p, LUGGED, ["bulldozing"], {"bulldozing": "bekker1969"}, {}) is None

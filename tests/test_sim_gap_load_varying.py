@@ -76,5 +76,8 @@ def test_generalised_laws_need_three_loads():
     assert fewer["wheel_flexibility"] == tuple(tm.PUBLISHED_LAWS["wheel_flexibility"])
     assert fewer["bulldozing"] == tuple(tm.PUBLISHED_LAWS["bulldozing"])
     assert "rankine_terzaghi1943~depth" in every["bulldozing"]
+    every = allowed_laws(base_model(), ["grousers"])
+    assert "bekker1956~slip" in every["grousers"]
+    assert for_loads(every, 2)["grousers"] == tuple(tm.PUBLISHED_LAWS["grousers"])
     only = {"slip_sinkage": ("ding2011~load",)}
     assert for_loads(only, 1) == only

@@ -144,6 +144,31 @@ def test_ding_lugs_add_slip_sinkage_in_proportion_to_lug_height():
     np.testing.assert_allclose(smooth["sinkage_m"], BB2.curves(180.0, slips)["sinkage_m"])
 
 
+def test_bekkers_lugs_with_lyaskos_slip_sinkage_by_hand():
+    """``bekker1956~slip``: Bekker's grouser law on a soil softened by Lyasko's factor
+    raised to g h/r, i.e. the same curves as Bekker's lugs with Lyasko's slip-sinkage of
+    coefficient g h/r; g = 0 is Bekker's law; a smooth wheel is untouched."""
+    law = "bekker1956~slip"
+    assert LAWS["grousers"][law].relaxes == "bekker1956"
+    assert tm.published_law("grousers", law) == "bekker1956"
+    lugged = BB2.with_effects(grousers={"law": law, "shear_radius_factor": 0.4,
+                                        "lug_slip_gain": 8.0})
+    by_hand = BB2.with_effects(grousers={"law": "bekker1956", "shear_radius_factor": 0.4},
+                               slip_sinkage={"law": "lyasko2010",
+                                             "coefficient": 8.0 * 0.0092 / 0.125})
+    loads, slips = np.array([[60.0], [250.0]]), np.linspace(-0.4, 0.8, 7)
+    for q in ("sinkage_m", "dp_n", "torque_nm"):
+        np.testing.assert_allclose(lugged.curves(loads, slips)[q], by_hand.curves(loads, slips)[q],
+                                   rtol=1e-9, atol=1e-12)
+    published = BB2.with_effects(grousers={"law": "bekker1956", "shear_radius_factor": 0.4})
+    at_zero = lugged.with_effects(grousers={"lug_slip_gain": 0.0})
+    np.testing.assert_array_equal(at_zero.curves(loads, slips)["dp_n"],
+                                  published.curves(loads, slips)["dp_n"])
+    smooth = lugged.with_wheel(grouser_height_m=0.0).curves(180.0, slips)
+    np.testing.assert_array_equal(smooth["sinkage_m"], BB2.curves(180.0, slips)["sinkage_m"])
+    assert np.all(np.diff(lugged.curves(180.0, slips[slips >= 0])["sinkage_m"]) > 0)
+
+
 def test_lyasko_slip_sinkage_coefficient():
     # (1 + i)/(1 - 0.5 i): 1, 4/3, 7/4, 16/7 at i = 0, 0.2, 0.4, 0.6; the Wong-Reece sinkage
     # follows Bekker's closed-form scaling within 4 %

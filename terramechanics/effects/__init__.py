@@ -16,6 +16,7 @@ from terramechanics.effects.grousers_bekker1956 import GrousersBekker1956
 from terramechanics.effects.grousers_ding2011 import GrousersDing2011
 from terramechanics.effects.depth_varying import COEFFICIENT_UPPER, depth_varying
 from terramechanics.effects.load_varying import STRENGTH, load_varying
+from terramechanics.effects.lug_slip_sinkage import EXTENDED, lug_slip_sinkage
 from terramechanics.effects.multipass_krenn_hirzinger2009 import MultipassKrennHirzinger2009
 from terramechanics.effects.multipass_wong2010 import MultipassWong2010
 from terramechanics.effects.reduced_gravity_reece1965 import ReducedGravityReece1965
@@ -39,13 +40,17 @@ for _cls in _ALL:
 
 #: effect -> law -> class: the published laws and, for the effects of
 #: ``load_varying.STRENGTH``, each with its strength varying with the load (``law~load``),
-#: for those of ``depth_varying.COEFFICIENT_UPPER`` with the rut depth (``law~depth``)
+#: for those of ``depth_varying.COEFFICIENT_UPPER`` with the rut depth (``law~depth``), and
+#: the grouser laws of ``lug_slip_sinkage.EXTENDED`` with the lugs' slip-sinkage (``law~slip``)
 LAWS: dict[str, dict[str, type[Effect]]] = {e: dict(laws) for e, laws in PUBLISHED_LAWS.items()}
 for (_name, _law), _strength in STRENGTH.items():
     _varying = load_varying(PUBLISHED_LAWS[_name][_law], _strength)
     LAWS[_name][_varying.law] = _varying
 for (_name, _law), _upper in COEFFICIENT_UPPER.items():
     _varying = depth_varying(PUBLISHED_LAWS[_name][_law], _upper)
+    LAWS[_name][_varying.law] = _varying
+for _name, _law in EXTENDED:
+    _varying = lug_slip_sinkage(PUBLISHED_LAWS[_name][_law])
     LAWS[_name][_varying.law] = _varying
 
 
