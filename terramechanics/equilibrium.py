@@ -26,7 +26,7 @@ def solve_increasing(f: Callable[[np.ndarray, np.ndarray | None], np.ndarray], h
     a, fa = np.zeros_like(target), -target  # f(0) = 0: no sinkage, no force
     b, fb = hi ** power, f(hi, None) - target
     tol = REL_TOL * np.abs(target)
-    x, fx = hi.copy(), fb.copy()
+    x = hi.copy()  # the sinkages evaluated (b is their u = x^power)
     active = np.flatnonzero((fb >= 0) & (np.abs(fb) > tol))
     for _ in range(max_iter):
         if active.size == 0:
@@ -46,6 +46,6 @@ def solve_increasing(f: Callable[[np.ndarray, np.ndarray | None], np.ndarray], h
         a[active] = np.where(flip, b_at, a_at)
         fa[active] = np.where(flip, fb_at, fa_at * np.where(shrink > 0, shrink, 0.5))
         b[active], fb[active] = c, fc
-        x[active], fx[active] = z, fc
+        x[active] = z
         active = active[np.abs(fc) > tol[active]]
-    return x, fx
+    return x, fb

@@ -23,10 +23,10 @@ other effects.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from terramechanics.effects.base import Effect, FitParam
-from terramechanics.effects.slip_sinkage_lyasko2010 import slip_sinkage_coefficient
+from terramechanics.effects.slip_sinkage_lyasko2010 import SlipSinkageLyasko2010
 
 #: suffix of a grouser law with the lugs' slip-sinkage
 SUFFIX = "~slip"
@@ -45,10 +45,9 @@ def lug_slip_sinkage(cls: type[Effect]) -> type[Effect]:
         fit = cls.fit + (FitParam("lug_slip_gain", 3.0, 0.0, 30.0),)
 
         def soil(self, soil, cond, wheel):
-            soil = super().soil(soil, cond, wheel)
-            exponent = self.lug_slip_gain * wheel.grouser_height_m / wheel.radius_m
-            softening = slip_sinkage_coefficient(cond.slip) ** (-exponent * (soil.n0 + 0.5))
-            return replace(soil, kc=soil.kc * softening, kphi=soil.kphi * softening)
+            lyasko = SlipSinkageLyasko2010(
+                coefficient=self.lug_slip_gain * wheel.grouser_height_m / wheel.radius_m)
+            return lyasko.soil(super().soil(soil, cond, wheel), cond, wheel)
 
     LugSlipSinkage.__name__ = LugSlipSinkage.__qualname__ = cls.__name__ + "LugSlipSinkage"
     LugSlipSinkage.__doc__ = (f"{cls.__name__} with the soil softened by Lyasko's K_s^(g h/r) "
