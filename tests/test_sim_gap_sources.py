@@ -28,6 +28,8 @@ ROOT = Path(__file__).resolve().parents[1]
 DING_POINTS = ROOT / "sim_gap" / "data" / "ding2011_points.csv"
 DING_MODEL = ROOT / "sim_gap" / "models" / "ding2011_simulant.toml"
 DING_ORIGINAL = ROOT / "terramechanics" / "data" / "ding2011_80n.csv"
+KLS1_POINTS = ROOT / "sim_gap" / "data" / "wang_han2016_points.csv"
+KLS1_MODEL = ROOT / "sim_gap" / "models" / "kls1_proxy.toml"
 HEADER = "source,wheel_radius_m,wheel_width_m,load_set_n,slip,dp_n,dp_n_se\n"
 
 
@@ -49,6 +51,31 @@ def test_ding_points_csv_holds_the_published_points():
     assert (wheels["ding2011_lug10"].grouser_count, wheels["ding2011_lug10"].grouser_height_m
             ) == (30, 0.010)
     assert wheels["ding2011_smooth"].grouser_count == 0
+
+
+def test_wang_han_points_and_why_their_proxied_soil_cannot_carry_them():
+    """The second shipped pair (docs/gap-report.md, Wang & Han 2016): the digitised values as
+    roverdevkit lists them (spot checks), and the reason the docs give for its inconclusive
+    verdict: the proxied soil sinks the smooth wheel 28-30 mm and the soil at the fit's
+    bounds (kphi x 5, phi - 10 deg) still 10-11 mm, more than measured (1-8 mm) at every slip."""
+    table = read_points_csv(KLS1_POINTS)
+    assert len(table) == 10 and set(table["source"]) == {"kls1_smooth", "kls1_lug10"}
+    lug = table[table["source"] == "kls1_lug10"].set_index("slip")
+    smooth = table[table["source"] == "kls1_smooth"].set_index("slip")
+    assert (lug.loc[0.4, "dp_n"], lug.loc[0.4, "sinkage_m"], lug.loc[0.5, "torque_nm"]) == (
+        12.7, 0.0096, 2.85)
+    assert (smooth.loc[0.1, "dp_n"], smooth.loc[0.5, "sinkage_m"]) == (-0.5, 0.008)
+    assert (lug["grouser_count"] == 16).all() and (lug["grouser_height_m"] == 0.010).all()
+    model = tm.load_model(KLS1_MODEL)
+    slips = smooth.index.to_numpy()
+    proxy = model.curves(58.86, slips)["sinkage_m"]
+    soil = model.soil
+    bound = model.with_soil(kphi=5 * soil.kphi, friction_angle_deg=soil.friction_angle_deg - 10)
+    at_bounds = bound.curves(58.86, slips)["sinkage_m"]
+    assert (proxy > 0.027).all() and (proxy < 0.031).all()
+    measured = smooth["sinkage_m"].to_numpy()
+    assert (at_bounds > 0.0095).all() and (at_bounds > measured).all()
+    assert at_bounds[0] > 5 * measured[0]  # 10 mm against 1 mm at slip 0.1
 
 
 def test_spread_with_repeats_becomes_a_standard_error(tmp_path):
