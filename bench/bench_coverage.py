@@ -32,10 +32,10 @@ SEEDS = {"virtual": tuple(range(157, 167)), "second": tuple(range(255, 265))}
 RUNS, QUICK_RUNS = 200, 60
 
 
-def _by_mode(scores: pd.DataFrame) -> pd.DataFrame:
-    """Coverage per quantity (rows) and run mode (columns)."""
-    return scores.pivot_table(index="quantity", columns="mode", values="covered",
-                              aggfunc="mean").loc[coverage(scores).index]
+def _covered_by(scores: pd.DataFrame, column: str, quantities) -> pd.DataFrame:
+    """Coverage per quantity (rows, in the order of ``quantities``) and ``column`` (columns)."""
+    return scores.pivot_table(index="quantity", columns=column, values="covered",
+                              aggfunc="mean").loc[quantities]
 
 
 def main(quick: bool = False) -> dict:
@@ -50,9 +50,9 @@ def main(quick: bool = False) -> dict:
                 scores.append(run_coverage(tmp, generator, runs, seed).assign(seed=seed))
         seconds = time.perf_counter() - t0
         pooled = pd.concat(scores, ignore_index=True)
-        table, modes = coverage(pooled), _by_mode(pooled)
-        per_seed = pooled.pivot_table(index="quantity", columns="seed", values="covered",
-                                      aggfunc="mean").loc[table.index]
+        table = coverage(pooled)
+        modes = _covered_by(pooled, "mode", table.index)
+        per_seed = _covered_by(pooled, "seed", table.index)
         print(f"{generator} (seeds {seeds[0]}-{seeds[-1]}, {len(seeds)} x {runs} runs, "
               f"{seconds:.0f} s):")
         print(table.round(3).to_string())

@@ -42,7 +42,7 @@ def grouser_geometries(points: pd.DataFrame, wheel) -> set[tuple[int, float]]:
     return {(int(wheel.grouser_count), float(wheel.grouser_height_m))}
 
 
-def lug_slip_sinkage(law: str, values: dict[str, float], wheel, max_slip: float) -> str | None:
+def lug_slip_sinkage_text(law: str, values: dict[str, float], wheel, max_slip: float) -> str | None:
     """What the lug slip-sinkage of ``law`` of grousers, with the fitted ``values``, does at
     ``max_slip``, in words; None for a law without that term or where it is negligible.
     Ding et al.'s lugs raise the sinkage exponent by ``kappa h/r s``; a ``~slip`` law
@@ -80,7 +80,7 @@ def aliasing_problem(points: pd.DataFrame, wheel, effects: list[str],
                 f"sink more as slip rises, Ding et al. 2011){fix}")
     if "grousers" in effects:
         max_slip = float(np.nanmax(np.abs(points["slip"].to_numpy(float))))
-        lugs = lug_slip_sinkage(laws["grousers"], values, wheel, max_slip)
+        lugs = lug_slip_sinkage_text(laws["grousers"], values, wheel, max_slip)
         if lugs is not None:
             return (f"{where} the grousers call rests on their slip-sinkage term ({lugs}), "
                     f"which the soil's own slip-sinkage would give as well{fix}")
