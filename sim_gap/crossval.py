@@ -70,15 +70,16 @@ class CrossValidated:
 def cross_validate(sim: Simulated, c: Candidate, points: pd.DataFrame,
                    sigma: dict[str, np.ndarray], start: dict[str, float] | None = None,
                    max_nfev: int = 40, fold_nfev: int = 15) -> CrossValidated:
-    """Fit on all points, then refit on each fold's training points (started from the full
-    fit) and keep the standardised residuals of the held-out points."""
+    """Fit on all points, then refit on each fold's training points from the same ``start``
+    as the full fit (never from the full fit, which has seen the held-out points) and keep
+    the standardised residuals of the held-out points."""
     full = fit_candidate(sim, c, points, sigma, start, max_nfev)
     held = []
     for name, mask in folds(points):
         train = _subset(points, ~mask)
         test = _subset(points, mask)
         fit = fit_candidate(sim, c, train, {q: s[~mask] for q, s in sigma.items()},
-                            full.values, fold_nfev)
+                            start, fold_nfev)
         r = standardised_residuals(test, sim.predict(test, fit.values),
                                    {q: s[mask] for q, s in sigma.items()})
         held.append((name, mask, r, fit.values))

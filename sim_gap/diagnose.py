@@ -1,6 +1,8 @@
-"""One gap diagnosis: where (residual map), which (candidates under each law of each
-effect, held-out ranking, a verdict that must hold under every law tried) and how far
-(held-out RMSE before and after). Pure: points and a simulation in, a dict out."""
+"""One gap diagnosis: where (residual map), which (the posterior probability of every
+hypothesis: no missing effect, each effect under each law of its family, pairs, an effect
+outside the candidates; :mod:`sim_gap.evidence`, :mod:`sim_gap.decide`), what the siblings
+show (:mod:`sim_gap.siblings`) and how far the gap shrinks (held-out RMSE before and after).
+Pure: points and a simulation in, a dict out."""
 
 from __future__ import annotations
 
@@ -13,17 +15,17 @@ import pandas as pd
 import terramechanics as tm
 
 from sim_gap import candidates as cands
-from sim_gap.crossval import CrossValidated, contrasts, cross_validate, folds
-from sim_gap.aliasing import SEPARATING_RUN, aliasing_problem
-from sim_gap.contrast_check import contrast_problem
-from sim_gap.decide import rank, unless
+from sim_gap.crossval import contrasts, cross_validate, folds
+from sim_gap.decide import by_effect, by_effect_set, decide, posterior
 from sim_gap.discriminate import separating_test
-from sim_gap.fit import quantities_of, sigmas, standardised_residuals
-from sim_gap.identify import identification_problem
-from sim_gap.laws import best_fitting_laws, reference_laws, robust_decide
+from sim_gap.evidence import TAU_GRID, Evidence, log_evidence, observations
+from sim_gap.fit import MapFit, fit_map, quantities_of, sigmas, strengths, to_values
+from sim_gap.hypotheses import OUTSIDE, admissible, hypothesis_priors, param_prior
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
+from sim_gap.siblings import contrasts as sibling_contrasts
 from sim_gap.simulated import Simulated
+from sim_gap.vocabulary import model_error_floor
 from swtlab.domain.gravity import G0_MPS2
 
 #: a standardised prediction change below this (max over points) makes an effect untestable
@@ -39,13 +41,13 @@ CONTRAST_NEEDED = {"multipass": "a second multipass level",
 
 @dataclass(frozen=True)
 class Settings:
-    """``max_nfev``/``fold_nfev``: evaluations of a full / a fold fit; ``n_boot``: bootstrap
-    replicates; ``jobs``: worker processes for the candidate fits; ``laws``: effect -> the
+    """``max_nfev``/``fold_nfev``: evaluations of a MAP fit / a held-out fold fit (the
+    shrink's two candidates); ``n_boot``: bootstrap replicates; ``jobs``: worker processes for the candidate fits; ``laws``: effect -> the
     laws its candidates may use (default: every law of the family; see
     ``sim_gap.candidates.allowed_laws``)."""
 
     max_nfev: int = 40
-    fold_nfev: int = 12
+    fold_nfev: int = 40
     n_boot: int = 200
     jobs: int = 1
     seed: int = 0
@@ -75,30 +77,81 @@ def testable(sim: Simulated, points: pd.DataFrame, laws: dict[str, tuple[str, ..
     return keep, dropped
 
 
-def _cv(args) -> CrossValidated:
+def _fit(args) -> MapFit:
     sim, c, points, sig, settings, start = args
-    return cross_validate(sim, c, points, sig, start, max_nfev=settings.max_nfev,
-                          fold_nfev=settings.fold_nfev)
+    return fit_map(sim, c, points, sig, param_prior(c, sim.model), start, settings.max_nfev)
 
 
-def _pair_start(c: cands.Candidate, singles: dict[str, CrossValidated]) -> dict[str, float]:
+def _pair_start(c: cands.Candidate, singles: dict[str, MapFit]) -> dict[str, float]:
     """Start of a pair's fit: the better single's fitted values (same law) plus the other
     effect's fitted strength."""
     fits = sorted((singles[f"{e}({law})"] for e, law in zip(c.effects, c.laws)),
-                  key=lambda cv: cv.full.chi2)
-    return {**fits[1].full.values, **fits[0].full.values}
+                  key=lambda f: f.fit.chi2)
+    return {**strengths(fits[1].fit.values), **strengths(fits[0].fit.values)}
 
 
-def _run_all(sim, candidate_list, points, sig, settings, starts=None
-             ) -> dict[str, CrossValidated]:
+def _fit_all(sim, candidate_list, points, sig, settings, starts=None) -> dict[str, MapFit]:
     starts = starts or [None] * len(candidate_list)
     jobs = [(sim, c, points, sig, settings, s) for c, s in zip(candidate_list, starts)]
     if settings.jobs > 1 and len(jobs) > 1:
         with ProcessPoolExecutor(settings.jobs) as pool:
-            done = list(pool.map(_cv, jobs))
+            done = list(pool.map(_fit, jobs))
     else:
-        done = [_cv(j) for j in jobs]
-    return {c.key: cv for c, cv in zip(candidate_list, done)}
+        done = [_fit(j) for j in jobs]
+    return {c.key: f for c, f in zip(candidate_list, done)}
+
+
+def _evidence(obs, sim: Simulated, f: MapFit, outside=None) -> Evidence:
+    centre, sd = param_prior(f.fit.candidate, sim.model)
+    return log_evidence(obs, f.predicted, f.jac, f.internal - centre, sd, outside)
+
+
+def _reference_laws(fits: dict[str, MapFit], evidence: dict[str, Evidence]) -> dict[str, str]:
+    """Per effect, the law of its single with the largest evidence."""
+    best: dict[str, tuple[float, str]] = {}
+    for key, f in fits.items():
+        c = f.fit.candidate
+        if len(c.effects) == 1 and (c.effects[0] not in best
+                                    or evidence[key].log_evidence > best[c.effects[0]][0]):
+            best[c.effects[0]] = (evidence[key].log_evidence, c.laws[0])
+    return {e: law for e, (_, law) in best.items()}
+
+
+def outside_amplitudes(sim: Simulated, points: pd.DataFrame, obs,
+                       singles: list[cands.Candidate]) -> np.ndarray:
+    """Amplitudes (floor units) of the discrepancy apart per source and level that stands for
+    an effect outside the candidates: a priori as large as the candidate effects are, i.e.
+    log-uniform from half the smallest to twice the largest RMS change (in floor units) that
+    one candidate effect makes at its prior centre, over five values."""
+    base = sim.predict(points, {})
+    quantities = quantities_of(points)
+    base_flat = np.column_stack([base[q] for q in quantities])[obs.where]
+    sizes = []
+    for c in singles:
+        if not c.effects:
+            continue
+        centre, _ = param_prior(c, sim.model)
+        pred = sim.predict(points, to_values(c, centre))
+        change = np.column_stack([pred[q] for q in quantities])[obs.where] - base_flat
+        sizes.append(float(np.sqrt(np.nanmean((change / obs.floor) ** 2))))
+    sizes = [s for s in sizes if np.isfinite(s) and s > 0] or [float(TAU_GRID[-1])]
+    lo, hi = max(0.5 * min(sizes), TAU_GRID[0]), max(2.0 * max(sizes), TAU_GRID[0])
+    return np.geomspace(lo, max(hi, lo), 5)
+
+
+def _separation(sim, points, obs, fits: dict[str, MapFit], a: str, b: str) -> float:
+    """Largest difference of two hypotheses' predictions at the measured conditions, in
+    units of the noise and discrepancy floor."""
+    d = fits[a].predicted - fits[b].predicted
+    return float(np.nanmax(np.abs(d) / np.hypot(obs.sigma, obs.floor)))
+
+
+def _fit_noise(points: pd.DataFrame, sig: dict[str, np.ndarray], radius_m: float
+               ) -> dict[str, np.ndarray]:
+    """The MAP fits' noise: the measured noise with the discrepancy at the middle of its grid
+    (one floor) in quadrature, as if independent."""
+    load = points["wheel_load_n"].to_numpy(float)
+    return {q: np.hypot(s, model_error_floor(q, load, radius_m)) for q, s in sig.items()}
 
 
 def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = None,
@@ -107,47 +160,85 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     ``effects``: the candidate effects (default: every effect the simulation lacks)."""
     settings = settings or Settings()
     asked = [e for e in (effects or sim.missing_effects()) if e in sim.missing_effects()]
+    admitted, excluded = admissible(asked, points)
     effects_ok, untestable = testable(sim, points,
-                                      cands.allowed_laws(sim.model, asked, settings.laws))
+                                      cands.allowed_laws(sim.model, admitted, settings.laws))
+    untestable.update({e: f"not a hypothesis here: it needs {need}"
+                       for e, need in excluded.items()})
     allowed = cands.for_loads(cands.allowed_laws(sim.model, effects_ok, settings.laws),
                               contrasts(points)["load"])
     sig = sigmas(points, sim.radius_m)
-    n = len(points)
-    results = _run_all(sim, cands.singles(sim.model, allowed), points, sig, settings)
-    reference = reference_laws(results, n)
-    pairs = cands.pairs(sim.model, allowed, reference)
-    results.update(_run_all(sim, pairs, points, sig, settings,
-                            [_pair_start(c, results) for c in pairs]))
-    decision = robust_decide(results, allowed, best_fitting_laws(results, reference, n), n)
-    chosen = results[decision["chosen"]].full
-    decision = unless(decision, identification_problem(sim, chosen, points, sig),
-                      "unidentifiable")
-    decision = unless(decision, aliasing_problem(
-        points, sim.model.wheel, list(chosen.candidate.effects),
-        dict(zip(chosen.candidate.effects, chosen.candidate.laws)), chosen.values), "aliased")
-    modelled = [e for e in tm.EFFECTS if e not in sim.missing_effects()]
-    decision = unless(decision, contrast_problem(
-        points, standardised_residuals(points, sim.predict(points, chosen.values), sig),
-        list(chosen.candidate.effects) + modelled), "level_contrast")
+    obs = observations(points, sig, sim.radius_m)
+    fit_sig = _fit_noise(points, sig, sim.radius_m)
+    single_list = cands.singles(sim.model, allowed)
+    fits = _fit_all(sim, single_list, points, fit_sig, settings)
+    evidence = {k: _evidence(obs, sim, f) for k, f in fits.items()}
+    pairs = cands.pairs(sim.model, allowed, _reference_laws(fits, evidence))
+    pair_fits = _fit_all(sim, pairs, points, fit_sig, settings,
+                         [_pair_start(c, fits) for c in pairs])
+    evidence.update({k: _evidence(obs, sim, f) for k, f in pair_fits.items()})
+    fits.update(pair_fits)
+    evidence[OUTSIDE] = _evidence(obs, sim, fits["soil_only"],
+                                  outside_amplitudes(sim, points, obs, single_list))
+    prior = hypothesis_priors([f.fit.candidate for f in fits.values()], len(allowed))
+    probability = posterior({k: e.log_evidence for k, e in evidence.items()}, prior)
+    hypotheses = sorted(
+        [_hypothesis(k, fits.get(k, fits["soil_only"]), evidence[k], prior[k], probability[k])
+         for k in evidence], key=lambda h: -h["probability"])
+    leaders = [h["key"] for h in hypotheses if h["key"] != OUTSIDE][:2]
+    separation = (_separation(sim, points, obs, fits, *leaders) if len(leaders) == 2 else None)
+    decision = decide(hypotheses, separation)
+    chosen = fits[decision["chosen"]].fit
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
                                "out: " + ", ".join(sorted(untestable)))
-    regions = residual_map(points, sim.predict(points, {}),
-                           sim.predict(points, results["soil_only"].full.values), sim.radius_m)
-    if decision.get("aliased"):
-        decision["separating_test"] = {"test": SEPARATING_RUN, "separation_sigma": None}
-    elif decision["verdict"] == "inconclusive" and len(decision["leaders"]) == 2:
-        a, b = (results[key].full.values for key in decision["leaders"])
-        decision["separating_test"] = separating_test(sim, points, a, b)
-    elif decision["verdict"] == "inconclusive":
+    soil_values = fits["soil_only"].fit.values
+    regions = residual_map(points, sim.predict(points, {}), sim.predict(points, soil_values),
+                           sim.radius_m)
+    if decision["verdict"] == "inconclusive" and len(leaders) == 2:
+        decision["separating_test"] = separating_test(sim, points, fits[leaders[0]].fit.values,
+                                                      fits[leaders[1]].fit.values)
+    elif decision["verdict"] == OUTSIDE:
         decision["separating_test"] = largest_gap(regions)
+    before = cross_validate(sim, fits["soil_only"].fit.candidate, points, sig, None,
+                            settings.max_nfev, settings.fold_nfev)
+    after = (before if chosen.candidate.key == "soil_only" else
+             cross_validate(sim, chosen.candidate, points, sig, None, settings.max_nfev,
+                            settings.fold_nfev))
+    predictions = {"simulation": sim.predict(points, {}), "soil_only": sim.predict(
+        points, soil_values), decision["chosen"]: sim.predict(points, chosen.values)}
     return {
-        "verdict": decision["verdict"], "decision": decision, "candidates": rank(results, n),
+        "verdict": decision["verdict"], "decision": decision, "hypotheses": hypotheses,
+        "effect_sets": by_effect_set(hypotheses),
+        "effect_probabilities": by_effect(hypotheses, list(allowed)),
         "untestable_effects": untestable, "contrasts": contrasts(points),
+        "sibling_contrasts": sibling_contrasts(points, sig, predictions),
         "folds": [name for name, _ in folds(points)],
-        "shrink": shrink(sim, points, results["soil_only"], results[decision["chosen"]],
-                         settings.n_boot, settings.seed),
-        "regions": regions,
-        "n_points": n, "quantities": quantities_of(points),
+        "shrink": shrink(sim, points, before, after, settings.n_boot, settings.seed),
+        "regions": regions, "noise": _noise_source(points),
+        "n_points": len(points), "quantities": quantities_of(points),
         "sinkage_relative": bool(points.attrs.get("sinkage_relative", False)),
     }
+
+
+def _noise_source(points: pd.DataFrame) -> dict[str, str]:
+    """Per quantity, where its noise comes from: measured replicates or the assumed floor."""
+    out = {}
+    for q in quantities_of(points):
+        col = f"{q}_repeat_sd"
+        measured = col in points and np.isfinite(points[col].to_numpy(float)).any()
+        out[q] = ("measured: the spread of replicate runs" if measured else
+                  "assumed: nothing measured the repeatability, so the floor of "
+                  "sim_gap.vocabulary.model_error_floor is used")
+    return out
+
+
+def _hypothesis(key: str, f: MapFit, e: Evidence, prior: float, probability: float) -> dict:
+    c = f.fit.candidate
+    outside = key == OUTSIDE
+    return {"key": key, "label": OUTSIDE if outside else c.label,
+            "effects": [] if outside else list(c.effects),
+            "laws": {} if outside else dict(zip(c.effects, c.laws)),
+            "n_params": f.fit.n_params, "log_evidence": e.log_evidence, "prior": prior,
+            "probability": probability, "discrepancy_tau": e.tau_mean,
+            "chi2": f.fit.chi2, "parameters": strengths(f.fit.values)}

@@ -9,32 +9,36 @@ from pathlib import Path
 from plain_json import jsonable
 from swtlab.atomic import write_atomically
 
-SCHEMA = "swtlab.gap-report/1"
+SCHEMA = "swtlab.gap-report/2"
+#: the schemas :mod:`campaign_report.gap` still reads
+READABLE_SCHEMAS = ("swtlab.gap-report/1", SCHEMA)
 
 
 def build_report(diagnosis: dict, measured_source: str, sim_source: str,
                  settings: dict | None = None) -> dict:
-    """The report dict: the issue's required keys first, then the details."""
+    """The report dict: the verdict and its probabilities first, then the details."""
     shrink = diagnosis["shrink"]
+    decision = diagnosis["decision"]
     out = {
         "schema": SCHEMA, "measured": measured_source, "simulated": sim_source,
         "verdict": diagnosis["verdict"],
-        "reason": diagnosis["decision"]["reason"],
-        "separating_test": diagnosis["decision"].get("separating_test"),
-        "chosen": diagnosis["decision"]["chosen"],
-        "candidates": [{k: c[k] for k in ("label", "effects", "laws", "held_out_score",
-                                          "held_out_loss", "z_vs_best", "n_params", "aicc",
-                                          "parameters", "fold_parameters",
-                                          "held_out_run_losses")}
-                       for c in diagnosis["candidates"]],
+        "probability": decision["probability"],
+        "call_probability": decision["call_probability"],
+        "reason": decision["reason"],
+        "separating_test": decision.get("separating_test"),
+        "chosen": decision["chosen"],
+        "leaders": decision["leaders"],
+        "effect_sets": diagnosis["effect_sets"],
+        "effect_probabilities": diagnosis["effect_probabilities"],
+        "hypotheses": diagnosis["hypotheses"],
+        "sibling_contrasts": diagnosis["sibling_contrasts"],
+        "noise": diagnosis["noise"],
         "held_out_rmse_before": shrink["held_out_rmse_before"],
         "held_out_rmse_after": shrink["held_out_rmse_after"],
         "shrink_pct": shrink["shrink_pct"],
         "shrink": {"per_quantity": shrink["per_quantity"],
                    "per_slip_band": shrink["per_slip_band"], "n_boot": shrink["n_boot"]},
         "regions": diagnosis["regions"],
-        "decision": {k: v for k, v in diagnosis["decision"].items()
-                     if k not in ("verdict", "reason", "separating_test")},
         "untestable_effects": diagnosis["untestable_effects"],
         "contrasts": diagnosis["contrasts"], "folds": diagnosis["folds"],
         "n_points": diagnosis["n_points"], "quantities": diagnosis["quantities"],
