@@ -59,13 +59,13 @@ def main(quick: bool = False) -> dict:
     start, cpu0 = time.perf_counter(), _cpu_s()
     report = diagnose(points, Simulated(base), None, Settings(n_boot=200, jobs=JOBS))
     seconds, cpu = time.perf_counter() - start, _cpu_s() - cpu0
-    out = {"runs": len(points), "candidates": len(report["candidates"]),
+    out = {"runs": len(points), "candidates": len(report["hypotheses"]) - 1,
            "effects_tested": 6 - len(report["untestable_effects"]),
            "verdict": report["verdict"], "seconds": seconds, "cpu_seconds": cpu, "jobs": JOBS,
            "goal_s": GOAL_S, "within_goal": seconds < GOAL_S}
     print(f"{out['runs']} runs, {out['effects_tested']} effects, {out['candidates']} candidates:"
           f" {seconds:.1f} s wall on {JOBS} workers, {cpu:.1f} CPU s (goal < {GOAL_S:.0f} s),"
-          f" verdict {report['verdict']}")
+          f" verdict {report['verdict']} (p = {report['decision']['probability']:.2f})")
     return out
 
 

@@ -45,7 +45,7 @@ def gap_report(points: pd.DataFrame, simulated: Simulated, measured_label: str,
                        "simulated": "each source's own wheel" if simulated.wheel_per_row
                        else simulated.wheel.geometry(),
                        "model_wheel": simulated.wheel.geometry(), "mismatches": mismatches}
-    tested = sorted({e for c in diagnosis["candidates"] for e in c["effects"]})
+    tested = sorted({e for h in diagnosis["hypotheses"] for e in h["effects"]})
     described = describe_sources(points, simulated, tested, settings.laws)
     report["sources"], report["effect_sources"] = described["sources"], described["effects"]
     return report

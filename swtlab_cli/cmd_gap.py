@@ -103,6 +103,8 @@ def run(args: argparse.Namespace) -> int:
     verdict = report["verdict"]
     print("verdict:", verdict if isinstance(verdict, str) else (", ".join(verdict) or "none"))
     print("reason:", report["reason"])
+    for entry in report["effect_sets"][:3]:
+        print(f"  P({entry['label']}) = {entry['probability']:.3f}")
     if report.get("separating_test"):
         print("test that would decide:", report["separating_test"]["test"])
     for q, before in report["held_out_rmse_before"].items():
