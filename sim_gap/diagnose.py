@@ -216,9 +216,32 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
         "folds": [name for name, _ in folds(points)],
         "shrink": shrink(sim, points, before, after, settings.n_boot, settings.seed),
         "regions": regions, "noise": _noise_source(points),
+        "points": _curves(points, sig, predictions),
         "n_points": len(points), "quantities": quantities_of(points),
         "sinkage_relative": bool(points.attrs.get("sinkage_relative", False)),
     }
+
+
+def _curves(points: pd.DataFrame, sig: dict[str, np.ndarray],
+            predictions: dict[str, dict[str, np.ndarray]]) -> list[dict]:
+    """Per measured point: its source and conditions, each quantity's value and noise, and
+    each prediction (the simulation as given, after soil recalibration, after the chosen
+    hypothesis) for the page's curves."""
+    source = points["source"] if "source" in points else [points.attrs.get("source", "")] * len(
+        points)
+    rows = []
+    for i in range(len(points)):
+        row = {"source": str(source[i]), "load_n": float(points["load_set_n"].iloc[i]),
+               "multipass": int(points["multipass"].iloc[i]),
+               "gravity_mps2": float(points["gravity_mps2"].iloc[i]),
+               "slip": float(points["slip"].iloc[i])}
+        for q in quantities_of(points):
+            value = float(points[q].iloc[i])
+            if np.isfinite(value):
+                row[q] = {"measured": value, "sigma": float(sig[q][i]),
+                          **{name: float(pred[q][i]) for name, pred in predictions.items()}}
+        rows.append(row)
+    return rows
 
 
 def _noise_source(points: pd.DataFrame) -> dict[str, str]:
