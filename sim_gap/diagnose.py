@@ -12,7 +12,6 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-import terramechanics as tm
 
 from sim_gap import candidates as cands
 from sim_gap.crossval import contrasts, cross_validate, folds
@@ -42,8 +41,9 @@ CONTRAST_NEEDED = {"multipass": "a second multipass level",
 @dataclass(frozen=True)
 class Settings:
     """``max_nfev``/``fold_nfev``: evaluations of a MAP fit / a held-out fold fit (the
-    shrink's two candidates); ``n_boot``: bootstrap replicates; ``jobs``: worker processes for the candidate fits; ``laws``: effect -> the
-    laws its candidates may use (default: every law of the family; see
+    shrink's two candidates); ``n_boot``: bootstrap replicates; ``jobs``: worker processes
+    for the candidate fits; ``laws``: effect -> the laws its candidates may use (default:
+    every law of the family; see
     ``sim_gap.candidates.allowed_laws``)."""
 
     max_nfev: int = 40

@@ -10,14 +10,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bench.bench_law_mimic import held_out_rms, truth_model, write_points
-from sim_gap.decide import UNEXPLAINED_LOSS
+from bench.bench_law_mimic import UNEXPLAINED_RMS_SIGMA, held_out_rms, truth_model, write_points
 from sim_gap.fit import sigmas
 from sim_gap.measured import from_points_csv
 from sim_gap.simulated import Simulated
 from validation.gap_bench import base_model
 
-BOUND_SIGMA = float(np.sqrt(UNEXPLAINED_LOSS))
+BOUND_SIGMA = UNEXPLAINED_RMS_SIGMA
 
 
 @pytest.mark.parametrize("family, truth, stand_in", [

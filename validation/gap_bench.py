@@ -302,18 +302,20 @@ def score(labels_path: Path, workdir: Path, truth_laws: str = "in-family") -> di
         if files.failure.exists():
             rows.append({"campaign": name, "hidden": hidden, "hidden_laws": label["laws"],
                          "allowed_laws": files.laws.read_text().strip(),
-                         "law_dependent": False, "called": None, "failed":
+                         "probability": None, "called": None, "failed":
                          files.failure.read_text().strip(), "class": ("none", "single", "pair")[
                              len(hidden)], "exact": False, "confident_wrong": False,
                          "mean_shrink_pct": None})
             continue
         report = json.loads(files.gap.read_text())
         verdict = report["verdict"]
-        called = None if verdict == "inconclusive" else sorted(verdict, key=EFFECT_NAMES.index)
+        # "outside_candidates" is a call too: every hidden effect here is a candidate
+        called = (None if verdict == "inconclusive" else verdict if isinstance(verdict, str)
+                  else sorted(verdict, key=EFFECT_NAMES.index))
         shrink = report["shrink_pct"]
         rows.append({"campaign": name, "hidden": hidden, "hidden_laws": label["laws"],
                      "allowed_laws": files.laws.read_text().strip(),
-                     "law_dependent": bool(report["decision"].get("law_dependent")),
+                     "probability": report.get("probability"),
                      "called": called, "failed": None,
                      "class": ("none", "single", "pair")[len(hidden)],
                      "exact": called == hidden,
