@@ -51,7 +51,7 @@ def main(quick: bool = False) -> dict:
             print(format_score(s))
             out[mode] = {"by_class": s["by_class"], "confusion": s["confusion"],
                          "confident_wrong_share": s["confident_wrong_share"],
-                         "law_dependent": s["law_dependent"], "timing_s": s["timing_s"],
+                         "outside_called": s["outside_called"], "timing_s": s["timing_s"],
                          "goals": verdict_on_goals(s)}
     return out
 

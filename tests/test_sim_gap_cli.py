@@ -18,13 +18,13 @@ from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import GapReport
 
-REQUIRED = {"verdict", "candidates", "held_out_rmse_before", "held_out_rmse_after",
+REQUIRED = {"verdict", "probability", "hypotheses", "effect_sets", "held_out_rmse_before", "held_out_rmse_after",
             "shrink_pct", "regions", "reason", "separating_test", "untestable_effects"}
 
 
 def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
-    """Multipass missing on the lugged BB2 wheel (a slip-sinkage truth on one lugged wheel
-    is aliased with the lugs': tests/test_sim_gap_aliasing.py)."""
+    """Multipass missing on the lugged BB2 wheel, in family (the truth is the model's own
+    multipass law)."""
     truth = base_model().with_effects(multipass={"stiffness_gain_per_pass": 0.6})
     vt.generate_campaign(tmp_path / "out", conditions(FAST_DESIGN)[:12], seed=3,
                          duration_s=FAST_DESIGN.duration_s,
@@ -41,8 +41,10 @@ def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
     assert REQUIRED <= set(report)
     assert report["n_points"] == 12 and report["contrasts"]["multipass"] == 2
     assert report["verdict"] == ["multipass"]
-    best = report["candidates"][0]
-    assert {"label", "held_out_score", "parameters", "aicc"} <= set(best)
+    assert report["probability"] >= report["call_probability"] == 0.9
+    best = report["hypotheses"][0]
+    assert {"key", "probability", "log_evidence", "parameters"} <= set(best)
+    assert best["effects"] == ["multipass"]
     assert report["shrink_pct"]["sinkage_m"] > 50.0
     assert all({"slip_band", "quantity", "z", "significant"} <= set(r) for r in report["regions"])
     html = (tmp_path / "gap.html").read_text()

@@ -351,7 +351,7 @@ def score(labels_path: Path, workdir: Path, truth_laws: str = "in-family") -> di
         / max(len(rows), 1),
         "failed": [f"{r['campaign']}: {r['failed']}" for r in rows if r["failed"]],
         "confident_wrong_share": sum(r["confident_wrong"] for r in rows) / max(len(rows), 1),
-        "law_dependent": sum(r["law_dependent"] for r in rows),
+        "outside_called": sum(r["called"] == "outside_candidates" for r in rows),
         "mean_shrink_pct": float(np.mean([r["mean_shrink_pct"] for r in effect_rows]))
         if effect_rows else None,
         "campaigns": rows})
@@ -367,8 +367,8 @@ def format_score(s: dict) -> str:
                      f"failed {v['failed']}")
     lines.append(f"exact-set accuracy {100 * s['exact_share']:.0f} %, inconclusive "
                  f"{100 * s['inconclusive_share']:.0f} %, confident wrong "
-                 f"{100 * s['confident_wrong_share']:.0f} %; inconclusive because the call "
-                 f"depended on a law: {s['law_dependent']}")
+                 f"{100 * s['confident_wrong_share']:.0f} %; called outside the candidates: "
+                 f"{s['outside_called']}")
     lines += [f"failed (scored as not exact): {f}" for f in s["failed"]]
     shrink = s["mean_shrink_pct"]
     lines.append("mean shrink (confident effect calls): "
