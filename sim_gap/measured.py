@@ -169,10 +169,17 @@ def from_cmu_smooth_runs(path: str | Path) -> pd.DataFrame:
     """The CMU 3d-terramechanics ``smooth_runs.csv`` (Pavlov, CMU; see its README): the
     straight-driving rows (slip angle 0). Drawbar pull = ``tractive_force_n``, load =
     ``wheel_load_n``, sinkage = minus the hub height (``-hub_z_mm``/1000) and therefore
-    **relative** (unknown zero; the diagnosis profiles out its offset). The file gives
-    per-run standard deviations of the 70-75 s window, not standard errors: the SE used
-    is the std (a conservative stand-in, the samples being strongly autocorrelated). The
-    wheel is the one of the shipped channel map of those logs (``cmu_3d_terramechanics``)."""
+    **relative** (unknown zero; the diagnosis profiles out its offset).
+
+    Noise is measured, not assumed: the file holds replicate runs of each set slip (two or
+    three trials at the same wheel and carriage speeds), whose spread, pooled over the
+    conditions (:func:`pooled_spread`, ISO 5725-2 repeatability), is each quantity's
+    ``<q>_repeat_sd``. The file's per-run standard deviations are the spread of the samples in
+    the 70-75 s window, not the standard error of the run's mean (the samples are strongly
+    autocorrelated, and they vary with the wheel's rotation): they are not used, and
+    ``<q>_se`` is NaN (unknown), so the repeatability alone is the points' noise
+    (:func:`sim_gap.fit.sigmas`). The wheel is the one of the shipped channel map of those
+    logs (``cmu_3d_terramechanics``)."""
     from ingest import load_channel_map
 
     raw = pd.read_csv(path)
@@ -180,12 +187,26 @@ def from_cmu_smooth_runs(path: str | Path) -> pd.DataFrame:
     table = pd.DataFrame({
         "run_id": raw["run_file"].astype(str), "load_set_n": raw["wheel_load_n"].mean(),
         "wheel_load_n": raw["wheel_load_n"], "multipass": 0, "gravity_mps2": G0_MPS2,
-        "slip": raw["slip"], "dp_n": raw["tractive_force_n"],
-        "dp_n_se": raw["tractive_force_std_n"], "sinkage_m": -raw["hub_z_mm"] / 1000.0,
-        "sinkage_m_se": np.maximum(raw["hub_z_std_mm"] / 1000.0, 1e-5)})
+        "slip": raw["slip"], "dp_n": raw["tractive_force_n"], "dp_n_se": np.nan,
+        "sinkage_m": -raw["hub_z_mm"] / 1000.0, "sinkage_m_se": np.nan})
+    condition = raw["wheel_surface_speed_mm_s"].round(0).to_numpy()
+    for q in ("dp_n", "sinkage_m"):
+        table[f"{q}_repeat_sd"] = pooled_spread(table[q].to_numpy(float), condition)
     defaults = load_channel_map(CMU_CHANNEL_MAP).metadata_defaults
     wheel = Wheel(name=defaults["run"]["wheel"], **defaults["wheel"])
     return _finish(table, str(path), wheel, sinkage_relative=True)
+
+
+def pooled_spread(values: np.ndarray, condition: np.ndarray) -> float:
+    """Pooled standard deviation of ``values`` over the groups of equal ``condition`` with
+    two or more members, ``sqrt(sum (n_i - 1) s_i^2 / sum (n_i - 1))`` (ISO 5725-2)."""
+    frame = pd.DataFrame({"v": values, "c": condition})
+    groups = frame.groupby("c")["v"]
+    dof = groups.count() - 1
+    keep = dof > 0
+    if not keep.any():
+        raise ValueError("no condition has replicate runs")
+    return float(np.sqrt(np.sum(dof[keep] * groups.var(ddof=1)[keep]) / np.sum(dof[keep])))
 
 
 #: the first bytes of every SQLite database file
