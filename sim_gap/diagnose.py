@@ -188,6 +188,7 @@ def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = N
     leaders = [h["key"] for h in hypotheses if h["key"] != OUTSIDE][:2]
     separation = (_separation(sim, points, obs, fits, *leaders) if len(leaders) == 2 else None)
     decision = decide(hypotheses, separation)
+    decision["reason"] += _discrepancy_text(points, sim, evidence[decision["chosen"]])
     chosen = fits[decision["chosen"]].fit
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
@@ -242,6 +243,19 @@ def _curves(points: pd.DataFrame, sig: dict[str, np.ndarray],
                           **{name: float(pred[q][i]) for name, pred in predictions.items()}}
         rows.append(row)
     return rows
+
+
+def _discrepancy_text(points: pd.DataFrame, sim: Simulated, e: Evidence) -> str:
+    """What the chosen hypothesis leaves to the base model's discrepancy, in newtons of
+    drawbar pull at the mean load (posterior mean amplitude times the floor)."""
+    load = float(points["wheel_load_n"].mean())
+    newtons = e.tau_mean * float(model_error_floor("dp_n", np.array([load]), sim.radius_m)[0])
+    text = (f"; it leaves a smooth base-model discrepancy of about {newtons:.2g} N of drawbar "
+            f"pull at {load:.0f} N ({e.tau_mean:.2g} times the repeatability floor)")
+    if e.tau_weights[-1] > 0.5:
+        text += (", at the top of the discrepancy's prior range: the simulation misses the "
+                 "measurements by more than the base-model error the diagnosis allows for")
+    return text
 
 
 def _noise_source(points: pd.DataFrame) -> dict[str, str]:
