@@ -14,8 +14,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from campaign_report.data import SetKey
-from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
-                                   plain_text)
+from campaign_report.style import (CURVE_QUANTITIES, LOAD_COLOURS, PER_LOAD_OF, QUANTITIES,
+                                   Palette, plain_text)
 from fitting import CurveFit, ValidationResult, band, curves_by_load, interpolate_load
 from sim_gap.vocabulary import SLIP_BAND_EDGES, slip_band_labels
 from wpm_export import WheelPerformanceModule
@@ -298,3 +298,88 @@ def gap_heatmap(regions: list[dict], tag: str = "") -> Figure:
                  + ": mean residual per region (* significant, Benjamini-Hochberg 5 %; "
                    "W load, r wheel radius)", fontsize=9)
     return fig
+
+
+def gap_probabilities(sets: list[tuple[str, float]], call_probability: float) -> Figure:
+    """The posterior probability of each effect set (``sets``: its name in words and its
+    probability, laws summed), one horizontal bar each, most probable on top, the value at
+    the bar's end and the probability a verdict needs (``call_probability``) as a line."""
+    fig = Figure(figsize=(8.0, 0.38 * len(sets) + 1.3), layout="constrained")
+    ax = fig.subplots()
+    names, values = [s[0] for s in sets], [s[1] for s in sets]
+    rows = np.arange(len(sets))
+    ax.barh(rows, values, color=LOAD_COLOURS[0], height=0.6)
+    for y, p in zip(rows, values):
+        ax.text(min(p, 1.0) + 0.01, y, probability_text(p), va="center", fontsize=8)
+    ax.axvline(call_probability, color="#D55E00", ls="--", lw=1.2)
+    ax.text(call_probability, -0.75, f"a verdict needs {call_probability:g}", ha="right",
+            va="bottom", fontsize=8, color="#D55E00")
+    ax.set_yticks(rows, [plain_text(n) for n in names], fontsize=9)
+    ax.set_ylim(len(sets) - 0.5, -1.0)
+    ax.set_xlim(0.0, 1.12)
+    ax.set_xticks(np.linspace(0.0, 1.0, 6))
+    ax.set_xlabel("posterior probability (laws of each effect summed)")
+    ax.grid(axis="x", alpha=0.3)
+    return fig
+
+
+def probability_text(p: float) -> str:
+    """A probability to three decimals; below 0.0005, ``< 0.001``."""
+    return f"{p:.3f}" if p >= 0.0005 else "< 0.001"
+
+
+#: the gap page's prediction lines: the simulation as given, after soil recalibration,
+#: after the chosen hypothesis (``<name>: (line style, width)``; any other name: the last)
+PREDICTION_LINES = {"simulation": (":", 1.2), "soil_only": ("--", 1.2), None: ("-", 1.8)}
+
+
+def gap_curves(points: list[dict], quantities: list[str], lines: dict[str, str],
+               palette: Palette, title: str, offsets: dict | None = None) -> Figure:
+    """Measured against simulated for one source at one multipass and gravity level: per
+    quantity, the measured values against slip per load (error bars ± σ, the noise the
+    diagnosis used) and each prediction of ``lines`` (key in the report's ``points`` ->
+    its legend text) through the measured slips, one colour per load. ``offsets``:
+    prediction key -> quantity -> a constant removed from that prediction (a relative
+    sinkage, measured from an unknown zero)."""
+    offsets = offsets or {}
+    shown = [q for q in quantities if any(q in p for p in points)]
+    fig = Figure(figsize=(11.0, 8.8 if len(shown) > 1 else 4.8), layout="constrained")
+    axes = _slip_axes(fig, shown) if len(shown) > 1 else [_one_slip_axis(fig, shown[0])]
+    loads = sorted({p["load_n"] for p in points})
+    for ax, q in zip(axes, shown):
+        scale = QUANTITIES[q].scale
+        for load in loads:
+            rows = sorted((p for p in points if p["load_n"] == load and q in p),
+                          key=lambda p: p["slip"])
+            if not rows:
+                continue
+            slip = np.array([p["slip"] for p in rows]) * 100.0
+            colour = palette.colour(load)
+            ax.errorbar(slip, [p[q]["measured"] * scale for p in rows],
+                        yerr=[p[q]["sigma"] * scale for p in rows], fmt="o", ms=MARKER_PT,
+                        color=colour, capsize=2.5, lw=1, zorder=3)
+            for key in lines:
+                ls, lw = PREDICTION_LINES.get(key, PREDICTION_LINES[None])
+                shift = offsets.get(key, {}).get(q, 0.0)
+                ax.plot(slip, [(p[q][key] - shift) * scale for p in rows], color=colour,
+                        ls=ls, lw=lw, marker="_" if len(rows) == 1 else None)
+    for ax in axes[len(shown):]:
+        ax.set_axis_off()
+    handles = palette.legend_handles(loads, [0])
+    handles.append(Line2D([], [], ls="", marker="o", color="0.2", label="measured ± σ"))
+    handles += [Line2D([], [], color="0.2", ls=PREDICTION_LINES.get(k, PREDICTION_LINES[None])[0],
+                       lw=PREDICTION_LINES.get(k, PREDICTION_LINES[None])[1], label=text)
+                for k, text in lines.items()]
+    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 4),
+               fontsize=8)
+    fig.suptitle(plain_text(title), fontsize="medium")
+    return fig
+
+
+def _one_slip_axis(fig: Figure, key: str):
+    ax = fig.subplots()
+    ax.set_xlabel(QUANTITIES["slip"].axis_label)
+    ax.set_ylabel(QUANTITIES[key].axis_label)
+    ax.set_title(QUANTITIES[key].label.capitalize(), fontsize="medium")
+    ax.grid(alpha=0.3)
+    return ax
