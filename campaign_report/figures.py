@@ -333,53 +333,61 @@ def probability_text(p: float) -> str:
 PREDICTION_LINES = {"simulation": (":", 1.2), "soil_only": ("--", 1.2), None: ("-", 1.8)}
 
 
-def gap_curves(points: list[dict], quantities: list[str], lines: dict[str, str],
-               palette: Palette, title: str, offsets: dict | None = None) -> Figure:
-    """Measured against simulated for one source at one multipass and gravity level: per
-    quantity, the measured values against slip per load (error bars ± σ, the noise the
-    diagnosis used) and each prediction of ``lines`` (key in the report's ``points`` ->
-    its legend text) through the measured slips, one colour per load. ``offsets``:
-    prediction key -> quantity -> a constant removed from that prediction (a relative
-    sinkage, measured from an unknown zero)."""
+def gap_curves(groups: list[tuple[str, list[dict]]], quantities: list[str],
+               lines: dict[str, str], palette: Palette, offsets: dict | None = None) -> Figure:
+    """Measured against simulated, one row per group (``(title, points)``: a source at one
+    multipass and gravity level, its points as the gap report's ``points``) and one column
+    per quantity: the measured values against slip per load (error bars ± σ, the noise the
+    diagnosis used) and each prediction of ``lines`` (key in the points -> its legend text)
+    through the measured slips, one colour per load. ``offsets``: prediction key ->
+    quantity -> a constant removed from that prediction (a relative sinkage, measured from
+    an unknown zero)."""
     offsets = offsets or {}
-    shown = [q for q in quantities if any(q in p for p in points)]
-    fig = Figure(figsize=(11.0, 8.8 if len(shown) > 1 else 4.8), layout="constrained")
-    axes = _slip_axes(fig, shown) if len(shown) > 1 else [_one_slip_axis(fig, shown[0])]
-    loads = sorted({p["load_n"] for p in points})
-    for ax, q in zip(axes, shown):
-        scale = QUANTITIES[q].scale
-        for load in loads:
-            rows = sorted((p for p in points if p["load_n"] == load and q in p),
-                          key=lambda p: p["slip"])
-            if not rows:
-                continue
-            slip = np.array([p["slip"] for p in rows]) * 100.0
-            colour = palette.colour(load)
-            ax.errorbar(slip, [p[q]["measured"] * scale for p in rows],
-                        yerr=[p[q]["sigma"] * scale for p in rows], fmt="o", ms=MARKER_PT,
-                        color=colour, capsize=2.5, lw=1, zorder=3)
-            for key in lines:
-                ls, lw = PREDICTION_LINES.get(key, PREDICTION_LINES[None])
-                shift = offsets.get(key, {}).get(q, 0.0)
-                ax.plot(slip, [(p[q][key] - shift) * scale for p in rows], color=colour,
-                        ls=ls, lw=lw, marker="_" if len(rows) == 1 else None)
-    for ax in axes[len(shown):]:
-        ax.set_axis_off()
+    fig = Figure(figsize=(3.3 * len(quantities) + 0.4, 3.0 * len(groups) + 0.9),
+                 layout="constrained")
+    axes = fig.subplots(len(groups), len(quantities), squeeze=False)
+    loads = sorted({p["load_n"] for _, points in groups for p in points})
+    for row, (title, points) in zip(axes, groups):
+        for ax, q in zip(row, quantities):
+            scale = QUANTITIES[q].scale
+            ax.set_title(f"{plain_text(title)}: {QUANTITIES[q].label}" if title
+                         else QUANTITIES[q].label.capitalize(), fontsize=9)
+            ax.set_xlabel(QUANTITIES["slip"].axis_label, fontsize=8)
+            ax.set_ylabel(QUANTITIES[q].axis_label, fontsize=8)
+            ax.tick_params(labelsize=7)
+            ax.grid(alpha=0.3)
+            for load in loads:
+                mine = sorted((p for p in points if p["load_n"] == load and q in p),
+                              key=lambda p: p["slip"])
+                if mine:
+                    _measured_and_predicted(ax, mine, q, lines, palette.colour(load),
+                                            {k: v.get(q, 0.0) * scale
+                                             for k, v in offsets.items()})
+            if not ax.has_data():
+                ax.text(0.5, 0.5, "not measured", ha="center", va="center",
+                        transform=ax.transAxes, color="0.4")
     handles = palette.legend_handles(loads, [0])
     handles.append(Line2D([], [], ls="", marker="o", color="0.2", label="measured ± σ"))
-    handles += [Line2D([], [], color="0.2", ls=PREDICTION_LINES.get(k, PREDICTION_LINES[None])[0],
-                       lw=PREDICTION_LINES.get(k, PREDICTION_LINES[None])[1], label=text)
+    handles += [Line2D([], [], color="0.2", ls=_style(k)[0], lw=_style(k)[1], label=text)
                 for k, text in lines.items()]
     fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 4),
                fontsize=8)
-    fig.suptitle(plain_text(title), fontsize="medium")
     return fig
 
 
-def _one_slip_axis(fig: Figure, key: str):
-    ax = fig.subplots()
-    ax.set_xlabel(QUANTITIES["slip"].axis_label)
-    ax.set_ylabel(QUANTITIES[key].axis_label)
-    ax.set_title(QUANTITIES[key].label.capitalize(), fontsize="medium")
-    ax.grid(alpha=0.3)
-    return ax
+def _style(key: str) -> tuple[str, float]:
+    return PREDICTION_LINES.get(key, PREDICTION_LINES[None])
+
+
+def _measured_and_predicted(ax, points: list[dict], q: str, lines, colour: str,
+                            shifts: dict[str, float]) -> None:
+    """One load's measured values ± σ and its predictions (display units, slip in %)."""
+    scale = QUANTITIES[q].scale
+    slip = np.array([p["slip"] for p in points]) * 100.0
+    ax.errorbar(slip, [p[q]["measured"] * scale for p in points],
+                yerr=[p[q]["sigma"] * scale for p in points], fmt="o", ms=MARKER_PT - 1,
+                color=colour, capsize=2.0, lw=1, zorder=3)
+    for key in lines:
+        ls, lw = _style(key)
+        ax.plot(slip, [p[q][key] * scale - shifts.get(key, 0.0) for p in points],
+                color=colour, ls=ls, lw=lw, marker="_" if len(points) == 1 else None)

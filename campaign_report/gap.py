@@ -114,6 +114,11 @@ def _units(text: str) -> str:
     return text.replace("m/s^2", "m/s²")
 
 
+def _listing(items: list[str]) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    return " and ".join([", ".join(items[:-1]), items[-1]] if len(items) > 1 else items)
+
+
 def _sentence(text: str) -> str:
     return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
 
@@ -388,7 +393,7 @@ def _noise_note(report: dict) -> list[Note]:
              "assumed": "assumed for {}: nothing measured their repeatability, so the "
                         "repeatability floor of each quantity stands in (with each run's own "
                         "standard uncertainty)"}
-    parts = [words.get(kind, kind + " for {}").format(" and ".join(names))
+    parts = [words.get(kind, kind + " for {}").format(_listing(names))
              for kind, names in kinds.items()]
     return [Note("Noise (the error bars, σ): " + "; ".join(parts) + ".",
                  warning="measured" not in kinds)] if parts else []
@@ -471,17 +476,18 @@ def _curve_blocks(report: dict) -> list[Block]:
     groups: dict[tuple, list[dict]] = {}
     for p in points:
         groups.setdefault((p["source"], p["multipass"], p["gravity_mps2"]), []).append(p)
-    several = {i: len({k[i] for k in groups}) > 1 for i in range(3)}
-    blocks: list[Block] = [Heading("Measured against simulated")]
+    several = [len({k[i] for k in groups}) > 1 for i in range(3)]
+    titled = [(", ".join(([source.rsplit("/", 1)[-1]] if several[0] else [])
+                         + ([f"multipass {mp}"] if several[1] else [])
+                         + ([f"{g:.3g} m/s²"] if several[2] else [])), rows)
+              for (source, mp, g), rows in groups.items()]
     offsets = _relative_offsets(report, names)
-    for n, ((source, mp, g), rows) in enumerate(groups.items()):
-        title = ", ".join([source] + ([f"multipass {mp}"] if several[1] else [])
-                          + ([f"gravity {g:.3g} m/s²"] if several[2] else []))
-        fig = gap_curves(rows, report["quantities"], names, palette,
-                         f"{title}: measured (± σ) and simulated")
-        blocks.append(Image(f"gap-curves-{n}", f"{title}: measured values ± σ against slip "
-                            "per load, beside " + ", ".join(names.values()),
-                            to_png(fig)[0]))
+    fig = gap_curves(titled, report["quantities"], names, palette, offsets)
+    blocks: list[Block] = [
+        Heading("Measured against simulated"),
+        Image("gap-curves", "Measured values ± σ against slip per load"
+              + (f" (rows: {', '.join(t for t, _ in titled)})" if len(titled) > 1 else "")
+              + ", beside " + _listing(list(names.values())), to_png(fig)[0])]
     if offsets:
         blocks.append(Note("Sinkage was measured from an unknown zero: each prediction's "
                            "mean sinkage residual is removed before it is drawn."))
@@ -497,8 +503,8 @@ def _pm_text(value: float, half: float, scale: float) -> tuple[str, str, int]:
 
 
 def _slips_text(slips: list[float]) -> str:
-    lo, hi = min(slips) * 100.0, max(slips) * 100.0
-    return f"slip {lo:.3g} %" if lo == hi else f"slips {lo:.3g} to {hi:.3g} %"
+    lo, hi = round(min(slips) * 100.0), round(max(slips) * 100.0)
+    return f"slip {lo} %" if lo == hi else f"slips {lo} to {hi} %"
 
 
 def _contrast_sentence(c: dict, chosen: str) -> str:
