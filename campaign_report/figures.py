@@ -4,6 +4,7 @@ in every figure (:class:`campaign_report.style.Palette`)."""
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -324,8 +325,10 @@ def gap_probabilities(sets: list[tuple[str, float]], call_probability: float) ->
 
 
 def probability_text(p: float) -> str:
-    """A probability to three decimals; below 0.0005, ``< 0.001``."""
-    return f"{p:.3f}" if p >= 0.0005 else "< 0.001"
+    """A probability to three decimals, cut rather than rounded (0.8995 reads 0.899: a
+    probability below the call is never shown at it, nor one below 1 as 1); below 0.001,
+    ``< 0.001``."""
+    return f"{math.floor(p * 1000.0 + 1e-9) / 1000.0:.3f}" if p >= 0.001 else "< 0.001"
 
 
 #: the gap page's prediction lines: the simulation as given, after soil recalibration,
