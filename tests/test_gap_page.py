@@ -69,7 +69,7 @@ def report() -> dict:
     sim = Simulated(tm.load_model(DING_SMOOTH_CALIBRATED))
     return json.loads(json.dumps(gap_report(  # as read back from the JSON file
         points, sim, "ding2011_points.csv", "ding2011_smooth_calibrated.toml",
-        settings=Settings(max_nfev=20, fold_nfev=8, n_boot=20))))
+        settings=Settings(max_nfev=20, fold_nfev=2, n_boot=10))))
 
 
 @pytest.fixture(scope="module")
