@@ -313,10 +313,10 @@ def gap_probabilities(sets: list[tuple[str, float]], call_probability: float) ->
     for y, p in zip(rows, values):
         ax.text(min(p, 1.0) + 0.01, y, probability_text(p), va="center", fontsize=8)
     ax.axvline(call_probability, color="#D55E00", ls="--", lw=1.2)
-    ax.text(call_probability, -0.75, f"a verdict needs {call_probability:g}", ha="right",
-            va="bottom", fontsize=8, color="#D55E00")
+    ax.text(call_probability, 1.01, f"a verdict needs {call_probability:g}", ha="center",
+            va="bottom", fontsize=8, color="#D55E00", transform=ax.get_xaxis_transform())
     ax.set_yticks(rows, [plain_text(n) for n in names], fontsize=9)
-    ax.set_ylim(len(sets) - 0.5, -1.0)
+    ax.set_ylim(len(sets) - 0.5, -0.5)
     ax.set_xlim(0.0, 1.12)
     ax.set_xticks(np.linspace(0.0, 1.0, 6))
     ax.set_xlabel("posterior probability (laws of each effect summed)")
@@ -326,8 +326,7 @@ def gap_probabilities(sets: list[tuple[str, float]], call_probability: float) ->
 
 def probability_text(p: float) -> str:
     """A probability to three decimals, cut rather than rounded (0.8995 reads 0.899: a
-    probability below the call is never shown at it, nor one below 1 as 1); below 0.001,
-    ``< 0.001``."""
+    probability below the call is never shown at it); below 0.001, ``< 0.001``."""
     return f"{math.floor(p * 1000.0 + 1e-9) / 1000.0:.3f}" if p >= 0.001 else "< 0.001"
 
 
