@@ -4,6 +4,7 @@ in every figure (:class:`campaign_report.style.Palette`)."""
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -14,8 +15,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from campaign_report.data import SetKey
-from campaign_report.style import (CURVE_QUANTITIES, PER_LOAD_OF, QUANTITIES, Palette,
-                                   plain_text)
+from campaign_report.style import (CURVE_QUANTITIES, LOAD_COLOURS, PER_LOAD_OF, QUANTITIES,
+                                   Palette, plain_text)
 from fitting import CurveFit, ValidationResult, band, curves_by_load, interpolate_load
 from sim_gap.vocabulary import SLIP_BAND_EDGES, slip_band_labels
 from wpm_export import WheelPerformanceModule
@@ -298,3 +299,97 @@ def gap_heatmap(regions: list[dict], tag: str = "") -> Figure:
                  + ": mean residual per region (* significant, Benjamini-Hochberg 5 %; "
                    "W load, r wheel radius)", fontsize=9)
     return fig
+
+
+def gap_probabilities(sets: list[tuple[str, float]], call_probability: float) -> Figure:
+    """The posterior probability of each effect set (``sets``: its name in words and its
+    probability, laws summed), one horizontal bar each, most probable on top, the value at
+    the bar's end and the probability a verdict needs (``call_probability``) as a line."""
+    fig = Figure(figsize=(8.0, 0.38 * len(sets) + 1.3), layout="constrained")
+    ax = fig.subplots()
+    names, values = [s[0] for s in sets], [s[1] for s in sets]
+    rows = np.arange(len(sets))
+    ax.barh(rows, values, color=LOAD_COLOURS[0], height=0.6)
+    for y, p in zip(rows, values):
+        ax.text(min(p, 1.0) + 0.01, y, probability_text(p), va="center", fontsize=8)
+    ax.axvline(call_probability, color="#D55E00", ls="--", lw=1.2)
+    ax.text(call_probability, 1.01, f"a verdict needs {call_probability:g}", ha="center",
+            va="bottom", fontsize=8, color="#D55E00", transform=ax.get_xaxis_transform())
+    ax.set_yticks(rows, [plain_text(n) for n in names], fontsize=9)
+    ax.set_ylim(len(sets) - 0.5, -0.5)
+    ax.set_xlim(0.0, 1.12)
+    ax.set_xticks(np.linspace(0.0, 1.0, 6))
+    ax.set_xlabel("posterior probability (laws of each effect summed)")
+    ax.grid(axis="x", alpha=0.3)
+    return fig
+
+
+def probability_text(p: float) -> str:
+    """A probability to three decimals, cut rather than rounded (0.8995 reads 0.899: a
+    probability below the call is never shown at it); below 0.001, ``< 0.001``."""
+    return f"{math.floor(p * 1000.0 + 1e-9) / 1000.0:.3f}" if p >= 0.001 else "< 0.001"
+
+
+#: the gap page's prediction lines: the simulation as given, after soil recalibration,
+#: after the chosen hypothesis (``<name>: (line style, width)``; any other name: the last)
+PREDICTION_LINES = {"simulation": (":", 1.2), "soil_only": ("--", 1.2), None: ("-", 1.8)}
+
+
+def gap_curves(groups: list[tuple[str, list[dict]]], quantities: list[str],
+               lines: dict[str, str], palette: Palette, offsets: dict | None = None) -> Figure:
+    """Measured against simulated, one row per group (``(title, points)``: a source at one
+    multipass and gravity level, its points as the gap report's ``points``) and one column
+    per quantity: the measured values against slip per load (error bars ± σ, the noise the
+    diagnosis used) and each prediction of ``lines`` (key in the points -> its legend text)
+    through the measured slips, one colour per load. ``offsets``: prediction key ->
+    quantity -> a constant removed from that prediction (a relative sinkage, measured from
+    an unknown zero)."""
+    offsets = offsets or {}
+    fig = Figure(figsize=(3.3 * len(quantities) + 0.4, 3.0 * len(groups) + 0.9),
+                 layout="constrained")
+    axes = fig.subplots(len(groups), len(quantities), squeeze=False)
+    loads = sorted({p["load_n"] for _, points in groups for p in points})
+    for row, (title, points) in zip(axes, groups):
+        for ax, q in zip(row, quantities):
+            scale = QUANTITIES[q].scale
+            ax.set_title(f"{plain_text(title)}: {QUANTITIES[q].label}" if title
+                         else QUANTITIES[q].label.capitalize(), fontsize=9)
+            ax.set_xlabel(QUANTITIES["slip"].axis_label, fontsize=8)
+            ax.set_ylabel(QUANTITIES[q].axis_label, fontsize=8)
+            ax.tick_params(labelsize=7)
+            ax.grid(alpha=0.3)
+            for load in loads:
+                mine = sorted((p for p in points if p["load_n"] == load and q in p),
+                              key=lambda p: p["slip"])
+                if mine:
+                    _measured_and_predicted(ax, mine, q, lines, palette.colour(load),
+                                            {k: v.get(q, 0.0) * scale
+                                             for k, v in offsets.items()})
+            if not ax.has_data():
+                ax.text(0.5, 0.5, "not measured", ha="center", va="center",
+                        transform=ax.transAxes, color="0.4")
+    handles = palette.legend_handles(loads, [0])
+    handles.append(Line2D([], [], ls="", marker="o", color="0.2", label="measured ± σ"))
+    handles += [Line2D([], [], color="0.2", ls=_style(k)[0], lw=_style(k)[1], label=text)
+                for k, text in lines.items()]
+    fig.legend(handles=handles, loc="outside lower center", ncols=min(len(handles), 4),
+               fontsize=8)
+    return fig
+
+
+def _style(key: str) -> tuple[str, float]:
+    return PREDICTION_LINES.get(key, PREDICTION_LINES[None])
+
+
+def _measured_and_predicted(ax, points: list[dict], q: str, lines, colour: str,
+                            shifts: dict[str, float]) -> None:
+    """One load's measured values ± σ and its predictions (display units, slip in %)."""
+    scale = QUANTITIES[q].scale
+    slip = np.array([p["slip"] for p in points]) * 100.0
+    ax.errorbar(slip, [p[q]["measured"] * scale for p in points],
+                yerr=[p[q]["sigma"] * scale for p in points], fmt="o", ms=MARKER_PT - 1,
+                color=colour, capsize=2.0, lw=1, zorder=3)
+    for key in lines:
+        ls, lw = _style(key)
+        ax.plot(slip, [p[q][key] * scale - shifts.get(key, 0.0) for p in points],
+                color=colour, ls=ls, lw=lw, marker="_" if len(points) == 1 else None)

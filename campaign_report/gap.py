@@ -1,16 +1,21 @@
-"""The sim-to-real gap report in words, tables and the residual map: one renderer for the
-page ``swtlab gap --html`` writes and for the section of the campaign report.
+"""The sim-to-real gap report in words, tables and figures: one renderer for the page
+``swtlab gap --html`` writes and for the section of the campaign report.
 
 The section appears in the campaign report when ``swtlab gap --measured <this database>``
 has recorded a report (docs/gap-report.md); it is registered as an optional section
 (:mod:`campaign_report.extensions`), its data (``data.extras["gap"]``) being
-``{"sim_source": ..., "report": ...}`` as ``gap_report`` stores them. Code names of the
-JSON (``dp_n``, ``soil.kphi``, ``slip_sinkage+grousers``) are shown by their plain names
-and units (:mod:`campaign_report.style`).
+``{"sim_source": ..., "report": ...}`` as ``gap_report`` stores them. Both schemas of
+:data:`sim_gap.report.READABLE_SCHEMAS` are read: schema 2 (posterior probabilities) with
+the verdict and its probability, the probabilities per effect set, the measured curves
+beside the simulation, the sibling contrasts and the next test; schema 1 (held-out scores)
+with its ranked candidates. Code names of the JSON (``dp_n``, ``soil.kphi``,
+``slip_sinkage(lyasko2010)``) are shown by their plain names and units
+(:mod:`campaign_report.style`); the report's ``reason`` is shown as written.
 """
 
 from __future__ import annotations
 
+import math
 import re
 from datetime import UTC, datetime
 from pathlib import Path
@@ -20,37 +25,51 @@ from sqlalchemy.orm import Session
 
 from campaign_report.data import CampaignData
 from campaign_report.extensions import Extension, register
-from campaign_report.figures import condition_text, gap_heatmap, slip_band_text, varying_factors
+from campaign_report.figures import (condition_text, gap_curves, gap_heatmap,
+                                     gap_probabilities, probability_text, slip_band_text,
+                                     varying_factors)
 from campaign_report.html import Block, Heading, Image, Note, Page, Section, Table, render_page
 from campaign_report.images import to_png
+from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, value_text
+from sim_gap.hypotheses import OUTSIDE
+from sim_gap.report import READABLE_SCHEMAS, SCHEMA
+from sim_gap.vocabulary import slip_band_labels
 from swtlab.atomic import write_atomically
 from terramechanics.effects.depth_varying import SUFFIX as DEPTH_VARYING
 from terramechanics.effects.load_varying import SUFFIX as LOAD_VARYING
 from terramechanics.effects.lug_slip_sinkage import SUFFIX as LUG_SLIP_SINKAGE
-from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, value_text
-from sim_gap.vocabulary import slip_band_labels
 from traceability.models import GapReport
 from traceability.provenance import swtlab_version
 
+SCHEMA_1 = READABLE_SCHEMAS[0]
+#: rows of the schema-1 candidates table and of the schema-2 hypotheses table
 CANDIDATES_SHOWN = 8
+#: bars of the probability chart (the most probable effect sets)
+SETS_SHOWN = 12
+#: sibling contrasts told in sentences (those furthest from zero in their uncertainty)
+CONTRASTS_TOLD = 6
 #: rows of a significant-regions table (the strongest; the heatmap shows every region)
 REGIONS_SHOWN = 12
 NAME = "gap"
 SOIL_ONLY = "soil_only"
 SOIL_ONLY_TEXT = "soil recalibration only"
+OUTSIDE_TEXT = "an effect outside the candidates"
+#: the predictions every schema-2 point carries besides the chosen hypothesis'
+SIMULATION = "simulation"
+PREDICTION_TEXT = {SIMULATION: "the simulation as given", SOIL_ONLY: SOIL_ONLY_TEXT}
 
 
 #: a generalised law's suffix in words
 VARYING_TEXT = {LOAD_VARYING: ", strength varying with load",
                 DEPTH_VARYING: ", resistance varying with rut depth",
                 LUG_SLIP_SINKAGE: ", with the lugs' slip-sinkage"}
-_SUFFIX = "(" + "|".join(map(re.escape, VARYING_TEXT)) + ")?"
+_LAW = re.compile(r"([a-z_]+?)(\d{4})(" + "|".join(map(re.escape, VARYING_TEXT)) + ")?")
 
 
 def law_text(law: str) -> str:
     """A law's key (``wong_kobayashi2012``) as its authors and year (Wong & Kobayashi 2012);
     a generalised law (``ding2011~load``) says so (Ding 2011, strength varying with load)."""
-    match = re.fullmatch(r"([a-z_]+?)(\d{4})" + _SUFFIX, law)
+    match = _LAW.fullmatch(law)
     if not match:
         return law
     text = " & ".join(n.capitalize() for n in match.group(1).split("_")) + " " + match.group(2)
@@ -65,42 +84,43 @@ def _effect_text(part: str) -> str:
 
 
 def candidate_text(label: str) -> str:
-    """A candidate label (``soil_only``, ``slip_sinkage+grousers``, with laws
-    ``grousers(ding2011)+slip_sinkage(lyasko2010)``) in plain words."""
+    """A hypothesis' key or an effect set's label (``soil_only``, ``slip_sinkage+grousers``,
+    with laws ``grousers(ding2011)+slip_sinkage(lyasko2010)``, ``outside_candidates``) in
+    plain words."""
     if label == SOIL_ONLY:
         return SOIL_ONLY_TEXT
+    if label == OUTSIDE:
+        return OUTSIDE_TEXT
     return " + ".join(_effect_text(e) for e in label.split("+"))
 
 
-def words(text: str, labels: list[str]) -> str:
-    """``text`` (written with the JSON's candidate labels, effect names and law keys) in plain
-    words: each label by its plain name, each law by its authors and year, each quantity by
-    its name, standard errors and sigmas spelt out."""
-    sets = {re.sub(r"\([^)]*\)", "", n) for n in labels}  # the effect sets, laws dropped
-    names = sorted({n for n in {*labels, *sets, *EFFECTS, SOIL_ONLY}
-                    if "_" in n or "+" in n or "(" in n}, key=len, reverse=True)
-    pattern = re.compile(r"(?<![\w+])(" + "|".join(map(re.escape, names)) + r")(?![\w+])")
-    text = pattern.sub(lambda m: candidate_text(m.group(1)), text)
-    text = re.sub(r"\b[a-z_]+?\d{4}" + _SUFFIX + r"\b", lambda m: law_text(m.group(0)),
-                  text)  # a law's key
-    text = re.sub(r"\b(" + "|".join(q for q in QUANTITIES if "_" in q) + r")\b",
-                  lambda m: QUANTITIES[m.group(1)].label, text)  # a quantity's column
-    text = re.sub(r"(\d) SE\b", r"\1 standard errors", text)
-    return re.sub(r"\bsigma\b", "σ", text).replace("m/s^2", "m/s²").strip()
-
-
-def plain(text: str, labels: list[str]) -> str:
-    """A reason of the report as a sentence (:func:`words`, a capital, a full stop)."""
-    text = words(text, labels)
-    return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
+def set_text(label: str) -> str:
+    """An effect set's label as the answer to "what does the simulation lack"."""
+    return "no missing effect" if label == SOIL_ONLY else candidate_text(label)
 
 
 def verdict_text(verdict) -> str:
+    if verdict == OUTSIDE:
+        return "the gap lies outside the candidate effects"
     if isinstance(verdict, str):
         return verdict
     if not verdict:
         return "no missing effect"
     return "the simulation lacks " + " and ".join(EFFECTS.get(e, e) for e in verdict)
+
+
+def _units(text: str) -> str:
+    """The report's ASCII unit spelling as the page writes it."""
+    return text.replace("m/s^2", "m/s²")
+
+
+def _listing(items: list[str]) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    return " and ".join([", ".join(items[:-1]), items[-1]] if len(items) > 1 else items)
+
+
+def _sentence(text: str) -> str:
+    return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
 
 
 def _parameters_text(values: dict[str, float]) -> str:
@@ -117,48 +137,66 @@ def _residual_text(quantity: str, si_value: float) -> str:
     return f"{'+' if si_value > 0 else ''}{value_text(QUANTITIES[quantity], si_value)}"
 
 
+def _region_text(report: dict, where: dict) -> str | None:
+    """Where the soil-recalibrated simulation misses most, for a gap no candidate carries."""
+    region = _region_of(report, where)
+    if region is None:
+        return None
+    varying = varying_factors(report["regions"]) | {"multipass", "gravity_mps2"}
+    return (f"No candidate effect explains the gap. After soil recalibration the "
+            f"simulation misses most in {QUANTITIES[region['quantity']].label} at slips "
+            f"{slip_band_text(region['slip_band'])} %, {condition_text(region, varying)}: "
+            "mean residual "
+            f"{_residual_text(region['quantity'], region['mean_residual_soil_recalibrated'])}"
+            f" (z = {region['z_soil_recalibrated']:.1f}).")
+
+
 def decisive_test_text(report: dict) -> str | None:
-    """The test that would decide (or, for an unexplained gap, where it is largest)."""
+    """The next test in words: the extra test that would tell the two leading named
+    hypotheses apart, or, for a gap outside the candidates, where it is largest."""
     test = report.get("separating_test")
     if not test:
         return None
-    labels = [c["label"] for c in report["candidates"]]
-    if test.get("region"):
-        region = _region_of(report, test["region"])
-        if region is None:
-            return None
-        varying = varying_factors(report["regions"]) | {"multipass", "gravity_mps2"}
-        return (f"No candidate effect explains the gap. After soil recalibration the "
-                f"simulation misses most in {QUANTITIES[region['quantity']].label} at slips "
-                f"{slip_band_text(region['slip_band'])} %, "
-                f"{condition_text(region, varying)}: mean residual "
-                f"{_residual_text(region['quantity'], region['mean_residual_soil_recalibrated'])}"
-                f" (z = {region['z_soil_recalibrated']:.1f}).")
-    if not test.get("test"):
-        return None
-    sigma = test.get("separation_sigma")
-    leaders = report.get("decision", {}).get("leaders") or []
+    schema2 = report.get("schema") == SCHEMA
+    if test.get("region"):  # schema 2: only for a verdict outside the candidates
+        return (_region_text(report, test["region"])
+                if not schema2 or report["verdict"] == OUTSIDE else None)
+    if schema2:
+        leaders = [h["key"] for h in report["hypotheses"] if h["key"] != OUTSIDE][:2]
+    else:
+        leaders = report.get("decision", {}).get("leaders") or []
     who = (" and ".join(candidate_text(x) for x in leaders) if len(leaders) == 2
            else "the two leading explanations")
-    return (f"Test that would decide: {words(test['test'], labels)}"
-            + (f"; {who} differ there by {sigma:.3g} σ (of the repeatability floor)."
+    if not test.get("test"):
+        return (f"None of the extra tests the diagnosis can propose would tell {who} apart; "
+                "more runs at the measured conditions narrow the noise instead.")
+    sigma = test.get("separation_sigma")
+    return (f"Next test: {_units(test['test'])}"
+            + (f"; {who} differ there by up to {sigma:.3g} σ (σ: the repeatability floor)."
                if sigma is not None else "."))
 
 
-def _untestable_notes(report: dict) -> list[Note]:
-    return [Note(plain(f"{EFFECTS.get(effect, effect)}: not testable with this campaign; "
-                       f"{why}", []))
-            for effect, why in report["untestable_effects"].items()]
+def _untestable_note(report: dict) -> list[Note]:
+    parts = [f"{EFFECTS.get(e, e)} ({_units(why)})"
+             for e, why in report["untestable_effects"].items()]
+    return [Note("Not tested with this campaign, so neither found nor ruled out: "
+                 + "; ".join(parts) + ".")] if parts else []
 
 
 def _wheel_and_source_notes(report: dict) -> list[Note]:
     """The wheel differences allowed (``--allow-wheel-mismatch``) and, with several measured
-    sources, which source each tested effect is seen on."""
-    labels = [c["label"] for c in report["candidates"]]
+    sources, on which of them each tested effect can show."""
     notes = [Note(f"Wheel MISMATCH allowed: {line} (measured vs simulated).", warning=True)
              for line in (report.get("wheel") or {}).get("mismatches", [])]
-    if len(report.get("sources") or []) > 1:
-        notes += [Note(plain(e["text"], labels)) for e in report["effect_sources"].values()]
+    sources = [s["name"] for s in report.get("sources") or []]
+    if len(sources) > 1:
+        parts = [f"{EFFECTS.get(e, e)} on "
+                 + ("every source" if set(v["sources"]) == set(sources)
+                    else ", ".join(v["sources"]) + " only")
+                 for e, v in report["effect_sources"].items()]
+        notes.append(Note(f"{len(sources)} measured sources ({', '.join(sources)}), one soil "
+                          "fitted on all; where each tested effect can show: "
+                          + "; ".join(parts) + "."))
     return notes
 
 
@@ -235,7 +273,7 @@ def _where_blocks(report: dict) -> list[Block]:
     return blocks
 
 
-def _which_blocks(report: dict) -> list[Block]:
+def _which_blocks_schema1(report: dict) -> list[Block]:
     rows = [[str(i + 1), candidate_text(c["label"]), f"{c['held_out_score']:.3g}",
              f"{c['z_vs_best']:.3g}", str(c["n_params"]), _parameters_text(c["parameters"])]
             for i, c in enumerate(report["candidates"][:CANDIDATES_SHOWN])]
@@ -323,18 +361,244 @@ def _folds_text(folds: list[str]) -> str:
         "no fold"
 
 
-def gap_blocks(report: dict) -> list[Block]:
-    """Everything the gap report shows, in order: verdict and reason, what could not be
-    tested, the test that would decide, where (residual maps and significant regions), which
-    (ranked explanations with fitted values) and how far (held-out RMSE before and after)."""
-    labels = [c["label"] for c in report["candidates"]]
+# --- schema 2: posterior probabilities -------------------------------------------------
+
+
+def _verdict_blocks(report: dict) -> list[Block]:
+    """The verdict with its probability, the rule, the leaders when inconclusive, the
+    report's reason as written and the next test."""
+    verdict, call = report["verdict"], report["call_probability"]
+    heading = verdict_text(verdict)
+    if verdict != "inconclusive":
+        heading += f" (probability {probability_text(report['probability'])})"
+    rule = f"A verdict names a hypothesis only when its probability is at least {call:g}."
+    if verdict == "inconclusive":
+        leaders = ", ".join(f"{set_text(x['label'])} {probability_text(x['probability'])}"
+                            for x in report["leaders"])
+        rule += f" None reaches it here; the most probable: {leaders}."
+    blocks: list[Block] = [Heading(f"Verdict: {heading}"),
+                           Note(rule, warning=verdict == "inconclusive"),
+                           Note(f"Reason, as the diagnosis writes it: {report['reason']}")]
+    if (test := decisive_test_text(report)) is not None:
+        blocks.append(Note(test))
+    return blocks
+
+
+def _noise_note(report: dict) -> list[Note]:
+    """Where the noise came from, per quantity: measured replicates or the assumed floor."""
+    kinds: dict[str, list[str]] = {}
+    for q, text in report["noise"].items():
+        kinds.setdefault(text.partition(":")[0], []).append(QUANTITIES[q].label)
+    words = {"measured": "measured (the spread of replicate runs) for {}",
+             "assumed": "assumed for {}: nothing measured their repeatability, so the "
+                        "repeatability floor of each quantity stands in (with each run's own "
+                        "standard uncertainty)"}
+    parts = [words.get(kind, kind + " for {}").format(_listing(names))
+             for kind, names in kinds.items()]
+    return [Note("Noise (the error bars, σ): " + "; ".join(parts) + ".",
+                 warning="measured" not in kinds)] if parts else []
+
+
+def _hypothesis_text(h: dict) -> str:
+    return candidate_text(h["key"])
+
+
+def _laws_text(h: dict) -> str:
+    return ", ".join(f"{EFFECTS.get(e, e)}: {law_text(law)}" for e, law in h["laws"].items())
+
+
+def _probability_blocks(report: dict) -> list[Block]:
+    """The bar chart of the effect sets' probabilities and the table of the most probable
+    hypotheses (effect set, laws, probability, log evidence, fitted strengths)."""
+    sets = report["effect_sets"]
+    shown = [(set_text(s["label"]), s["probability"]) for s in sets[:SETS_SHOWN]]
+    rest = len(sets) - len(shown)
+    caption = ("Posterior probability of each effect set (its laws summed); the dashed line: "
+               f"the probability a verdict needs ({report['call_probability']:g})"
+               + (f"; {rest} less probable sets not drawn" if rest > 0 else ""))
+    chart = Image("gap-probabilities", caption,
+                  to_png(gap_probabilities(shown, report["call_probability"]))[0])
+    hypotheses = report["hypotheses"][:CANDIDATES_SHOWN]
+    rows = [[str(i + 1), set_text(h["label"]), _laws_text(h) or "—",
+             probability_text(h["probability"]), f"{h['log_evidence']:.1f}",
+             _parameters_text({k: v for k, v in h["parameters"].items()
+                               if not k.startswith("soil.")}) or "—"]
+            for i, h in enumerate(hypotheses)]
+    effects = ", ".join(f"{EFFECTS.get(e, e)} {probability_text(p)}"
+                        for e, p in sorted(report["effect_probabilities"].items(),
+                                           key=lambda x: -x[1]))
+    chosen = next(h for h in report["hypotheses"] if h["key"] == report["chosen"])
+    more = len(report["hypotheses"]) - len(hypotheses)
+    return [Heading("Which: the probability of each explanation"), chart,
+            Note("Each hypothesis frees the soil and the strengths of its effects (priors: the "
+                 "published soils and the ranges the laws cite) and is weighed by its evidence "
+                 "(log evidence, natural log) and its prior; the outside hypothesis lets a "
+                 "discrepancy no candidate shapes carry the gap."
+                 + (f" Probability that each effect is part of the explanation: {effects}."
+                    if effects else "")
+                 + (f" {more} less probable hypotheses in the JSON report." if more > 0
+                    else "")),
+            Table(["rank", "effect set", "laws", "probability", "log evidence",
+                   "fitted strengths"], rows, numeric=frozenset({0, 3, 4})),
+            Note(f"Soil fitted under the most probable named hypothesis "
+                 f"({_hypothesis_text(chosen)}): "
+                 + _parameters_text({k: v for k, v in chosen["parameters"].items()
+                                     if k.startswith("soil.")}) + ".")]
+
+
+def _prediction_names(report: dict) -> dict[str, str]:
+    """The predictions the points carry (key -> words): as given, soil only, chosen."""
+    names = dict(PREDICTION_TEXT)
+    if report["chosen"] not in names:
+        names[report["chosen"]] = f"with {candidate_text(report['chosen'])}"
+    return names
+
+
+def _relative_offsets(report: dict, names) -> dict:
+    """For a relative sinkage (unknown zero): each prediction's mean sinkage residual over
+    all points, removed before it is drawn (as the diagnosis removes it)."""
+    if not report.get("sinkage_relative"):
+        return {}
+    rows = [p["sinkage_m"] for p in report["points"] if "sinkage_m" in p]
+    return {k: {"sinkage_m": sum(r[k] - r["measured"] for r in rows) / len(rows)}
+            for k in names} if rows else {}
+
+
+def _curve_blocks(report: dict) -> list[Block]:
+    """Per source (and multipass and gravity level), the measured values against slip
+    beside the simulation as given, after soil recalibration and after the chosen
+    hypothesis."""
+    points = report["points"]
+    if not points:
+        return []
+    names = _prediction_names(report)
+    palette = Palette([p["load_n"] for p in points], [p["multipass"] for p in points])
+    groups: dict[tuple, list[dict]] = {}
+    for p in points:
+        groups.setdefault((p["source"], p["multipass"], p["gravity_mps2"]), []).append(p)
+    several = [len({k[i] for k in groups}) > 1 for i in range(3)]
+    titled = [(", ".join(([source.rsplit("/", 1)[-1]] if several[0] else [])
+                         + ([f"multipass {mp}"] if several[1] else [])
+                         + ([f"{g:.3g} m/s²"] if several[2] else [])), rows)
+              for (source, mp, g), rows in groups.items()]
+    offsets = _relative_offsets(report, names)
+    fig = gap_curves(titled, report["quantities"], names, palette, offsets)
+    blocks: list[Block] = [
+        Heading("Measured against simulated"),
+        Image("gap-curves", "Measured values ± σ against slip per load"
+              + (f" (rows: {', '.join(t for t, _ in titled)})" if len(titled) > 1 else "")
+              + ", beside " + _listing(list(names.values())), to_png(fig)[0])]
+    if offsets:
+        blocks.append(Note("Sinkage was measured from an unknown zero: each prediction's "
+                           "mean sinkage residual is removed before it is drawn."))
+    return blocks
+
+
+def _pm_text(value: float, half: float, scale: float) -> tuple[str, str, int]:
+    """``value`` and a 95 % half-width in display units, both to the half-width's second
+    significant digit: (value, half-width, decimals)."""
+    v, h = value * scale, half * scale
+    decimals = max(0, 1 - math.floor(math.log10(h))) if h > 0 else 3
+    return f"{v:+.{decimals}f}", f"{h:.{decimals}f}", decimals
+
+
+def _slips_text(slips: list[float]) -> str:
+    lo, hi = round(min(slips) * 100.0), round(max(slips) * 100.0)
+    return f"slip {lo} %" if lo == hi else f"slips {lo} to {hi} %"
+
+
+def _contrast_sentence(c: dict, chosen: str) -> str:
+    """``the lugged wheel minus its smooth twin: +2.1 ± 0.4 N of drawbar pull at 80 N (...);
+    predicted by grousers (Ding 2011): +1.9 N (the simulation as given: +0.0 N)``."""
+    q = QUANTITIES[c["quantity"]]
+    half = (c["ci95"][1] - c["ci95"][0]) / 2.0
+    value, pm, decimals = _pm_text(c["contrast"], half, q.scale)
+    predicted = c["predicted"]
+    told = ""
+    if chosen in predicted:
+        told = f"; predicted by {candidate_text(chosen)}: " \
+               f"{predicted[chosen] * q.scale:+.{decimals}f} {q.unit}"
+        if SIMULATION in predicted:
+            told += (f" ({PREDICTION_TEXT[SIMULATION]}: "
+                     f"{predicted[SIMULATION] * q.scale:+.{decimals}f} {q.unit})")
+    return _sentence(f"{_units(c['contrast_of'])}: {value} ± {pm} {q.unit} of {q.label} at "
+                     f"{c['load_n']:g} N (95 % interval; {_slips_text(c['slips'])}, "
+                     f"{c['n']} matched runs){told}")
+
+
+def _contrast_blocks(report: dict) -> list[Block]:
+    """The sibling contrasts: what one feature changes at matched conditions, measured
+    (with its 95 % interval) beside each prediction's contrast; sentences for those whose
+    interval excludes zero (at most :data:`CONTRASTS_TOLD`), every one in the table."""
+    contrasts = report["sibling_contrasts"]
+    if not contrasts:
+        return []
+    names = _prediction_names(report)
+    clear = sorted((c for c in contrasts if c["ci95"][0] > 0 or c["ci95"][1] < 0),
+                   key=lambda c: -abs(c["contrast"]) / c["u"])
+    told = [Note(_contrast_sentence(c, report["chosen"])) for c in clear[:CONTRASTS_TOLD]]
+    if not clear:
+        told = [Note("No measured contrast differs from zero at 95 %: what the sibling runs "
+                     "differ in changes nothing beyond their noise here.")]
+    elif len(clear) > CONTRASTS_TOLD:
+        told.append(Note(f"{len(clear) - CONTRASTS_TOLD} more contrasts differ from zero at "
+                         "95 %: in the table."))
+    quantities = list(dict.fromkeys(c["quantity"] for c in contrasts))
+    cells: dict[tuple, dict[str, dict]] = {}
+    for c in contrasts:
+        cells.setdefault((c["contrast_of"], c["load_n"]), {})[c["quantity"]] = c
+    rows = []
+    for (of, load), per in cells.items():
+        shown = {q: _pm_text(c["contrast"], (c["ci95"][1] - c["ci95"][0]) / 2.0,
+                             QUANTITIES[q].scale) for q, c in per.items()}
+        rows.append([_units(of), f"{load:g}", "measured (± 95 %)"]
+                    + [f"{shown[q][0]} ± {shown[q][1]}" if q in shown else ""
+                       for q in quantities])
+        for key, text in names.items():
+            rows.append(["", "", text] + [
+                f"{per[q]['predicted'][key] * QUANTITIES[q].scale:+.{shown[q][2]}f}"
+                if q in per and key in per[q]["predicted"] else "" for q in quantities])
+    header = (["contrast", "load [N]", ""]
+              + [QUANTITIES[q].axis_label for q in quantities])
+    return [Heading("Sibling contrasts: what one feature changes, at matched conditions"),
+            Note("Runs that differ in one feature (a lugged wheel and its smooth twin, a later "
+                 "soil pass, another gravity) are paired at the same load and slip (the other "
+                 "side interpolated in slip); a base-model error common to both cancels in "
+                 "the difference, so an effect must explain what is left."),
+            *told,
+            Table(header, rows, numeric=frozenset({1, *range(3, len(header))}))]
+
+
+def _schema2_blocks(report: dict) -> list[Block]:
+    return (_verdict_blocks(report) + _noise_note(report) + _untestable_note(report)
+            + _wheel_and_source_notes(report) + _probability_blocks(report)
+            + _curve_blocks(report) + _contrast_blocks(report) + _where_blocks(report)
+            + _how_far_blocks(report))
+
+
+def _schema1_blocks(report: dict) -> list[Block]:
     blocks: list[Block] = [Heading(f"Verdict: {verdict_text(report['verdict'])}"),
-                           Note(plain(report["reason"], labels),
+                           Note(f"Reason, as the diagnosis writes it: {report['reason']}",
                                 warning=report["verdict"] == "inconclusive")]
     if (test := decisive_test_text(report)) is not None:
         blocks.append(Note(test))
-    blocks += _untestable_notes(report) + _wheel_and_source_notes(report)
-    return blocks + _where_blocks(report) + _which_blocks(report) + _how_far_blocks(report)
+    return (blocks + _untestable_note(report) + _wheel_and_source_notes(report)
+            + _where_blocks(report) + _which_blocks_schema1(report) + _how_far_blocks(report))
+
+
+def gap_blocks(report: dict) -> list[Block]:
+    """Everything the gap report shows, in order. Schema 2: the verdict with its
+    probability and the rule, the reason, the next test, where the noise came from, what
+    could not be tested, the probabilities (chart and table), the measured curves beside the
+    simulation, the sibling contrasts, where (residual maps) and how far (held-out RMSE).
+    Schema 1: verdict, reason, test, where, the ranked candidates and how far."""
+    schema = report.get("schema", SCHEMA_1)
+    if schema == SCHEMA:
+        return _schema2_blocks(report)
+    if schema == SCHEMA_1:
+        return _schema1_blocks(report)
+    return [Note(f"This gap report has schema {schema}; this swtlab reads "
+                 f"{', '.join(READABLE_SCHEMAS)}: a newer swtlab shows it.", warning=True)]
 
 
 def gather_gap(session: Session, data: CampaignData) -> dict | None:
