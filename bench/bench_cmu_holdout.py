@@ -26,7 +26,7 @@ def main(quick: bool = False) -> dict:
         return {"skipped": True}
     points = from_cmu_smooth_runs(RUNS)
     start = time.perf_counter()
-    table = holdout_dp(points, tm.load_model(START), n_starts=1 if quick else 5)
+    table = holdout_dp(points, tm.load_model(START), n_starts=1 if quick else 5, max_nfev=600)
     seconds = time.perf_counter() - start
     summary = holdout_summary(table)
     edges = HOLDOUT_BAND_EDGES

@@ -56,14 +56,17 @@ def by_effect(hypotheses: list[dict], effects: list[str]) -> dict[str, float]:
 
 
 def _words(label: str) -> str:
+    """An effect set in plain words (``grousers+slip_sinkage`` -> ``grousers + slip
+    sinkage``)."""
     return {"soil_only": "no missing effect", OUTSIDE: "an effect outside the candidates"
-            }.get(label, label.replace("+", " + "))
+            }.get(label, label.replace("+", " + ").replace("_", " "))
 
 
 def decide(hypotheses: list[dict], separation_sigma: float | None = None) -> dict:
     """The verdict from ``hypotheses`` (each with ``key``, ``effects``, ``probability``).
-    ``separation_sigma``: the largest standardised difference between the two leading
-    hypotheses' predictions at the measured conditions (None if not computed). Returns
+    ``separation_sigma``: the largest standardised difference between the two leading named
+    hypotheses' predictions at the measured conditions (None if not computed; below one
+    sigma the reason says the points cannot tell them apart). Returns
     ``verdict`` (effects, ``"outside_candidates"`` or ``"inconclusive"``), ``chosen`` (the most
     probable named hypothesis' key), ``probability`` (of the leading set), ``leaders``
     (the two leading sets with their probabilities), ``call_probability`` and ``reason``."""
@@ -74,7 +77,7 @@ def decide(hypotheses: list[dict], separation_sigma: float | None = None) -> dic
     chosen = max(in_lead, key=lambda h: h["probability"])["key"]
     leaders = [{"label": s["label"], "probability": s["probability"]} for s in sets[:2]]
     out = {"chosen": chosen, "probability": lead["probability"], "leaders": leaders,
-           "call_probability": CALL_PROBABILITY}
+           "call_probability": CALL_PROBABILITY, "leaders_separation_sigma": separation_sigma}
     p = f"{lead['probability']:.2f}"
     if lead["probability"] >= CALL_PROBABILITY:
         verdict = OUTSIDE if lead["label"] == OUTSIDE else list(lead["effects"])
@@ -90,6 +93,6 @@ def decide(hypotheses: list[dict], separation_sigma: float | None = None) -> dic
     if second is not None:
         reason += f", {_words(second['label'])} {second['probability']:.2f}"
         if separation_sigma is not None and separation_sigma < 1.0:
-            reason += (f"; their predictions differ by at most {separation_sigma:.1f} sigma "
+            reason += (f"; their predictions differ by at most {separation_sigma:.1f} σ "
                        "at the measured conditions: these points cannot tell them apart")
     return {**out, "verdict": "inconclusive", "reason": reason}

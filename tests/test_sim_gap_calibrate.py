@@ -100,7 +100,9 @@ def test_cmu_smooth_wheel_held_out_slip_bands():
     10 % of the measured DP range (measured with 5 starts in ``python -m bench
     cmu_holdout``: 3.73 N of 41.1 N; one start finds the same optimum here)."""
     points = from_cmu_smooth_runs(CMU_RUNS)
-    table = holdout_dp(points, tm.load_model(START), n_starts=1)
+    # the triplicates' noise (0.34 N) is tighter than the window spreads it replaced, so the
+    # MAP takes more evaluations than calibrate_soil's default to converge
+    table = holdout_dp(points, tm.load_model(START), n_starts=1, max_nfev=600)
     summary = holdout_summary(table)
     assert (table["status"] == "ok").all()
     assert summary["dp_range_n"] == pytest.approx(41.13, abs=0.01)
