@@ -38,6 +38,14 @@ class SlipSolution:
     value: np.ndarray
     status: np.ndarray
 
+    @classmethod
+    def of(cls, slip: np.ndarray, value: np.ndarray, status: np.ndarray) -> SlipSolution:
+        """The same as ``SlipSolution(slip=..., value=..., status=...)``, built without the
+        frozen dataclass's checked ``__init__`` (a third of a scalar ``slip_for``)."""
+        out = object.__new__(cls)
+        out.__dict__.update(slip=slip, value=value, status=status)
+        return out
+
     @property
     def reached(self) -> np.ndarray:
         return (self.status == STATUS_OK) | (self.status == STATUS_STEP)

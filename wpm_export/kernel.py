@@ -481,3 +481,4 @@ def solve_rows(coefficients, below_zero, row, targets, lo, hi, slip, value, stat
             m, jump = _cuts(w, n, lo, hi, w)
             last = r
         slip[i], value[i], status[i] = _find(targets[i], n, lo, m, jump, w)
+

@@ -29,6 +29,9 @@ from wpm_export.schema import UNITS, WpmSelectionError
 CurveSet = tuple[str, str, int]  # (soil, wheel, multipass)
 #: status text by kernel code (status + 4 when the load was extrapolated)
 STATUS = ("ok", "above_max", "below_min", "at_step") * 2
+_STATUS_0D = {s: np.array(s, dtype="<U9") for s in STATUS[:4]}  # shared, read-only
+for _status in _STATUS_0D.values():
+    _status.flags.writeable = False
 
 
 def _selection_text(soil, wheel, multipass) -> str:
@@ -271,11 +274,14 @@ class WheelPerformanceModule:
         falls inside the jump at zero slip (:mod:`wpm_export.inverse`); ``value`` is the
         target where it is reached. Exact to rounding (the root to 1e-14)."""
         if isinstance(target, (float, int)) and isinstance(load_n, (float, int)):
-            slip, value, status = self.slip_for_one(
-                quantity, target, load_n, soil=soil, wheel=wheel, multipass=multipass,
-                allow_extrapolation=allow_extrapolation)
-            return SlipSolution(slip=np.array(slip), value=np.array(value),
-                                status=np.array(status, dtype="<U9"))
+            table = self._packed.get((quantity, soil, wheel, multipass))
+            if table is None:
+                table = self._table(quantity, soil, wheel, multipass)
+            slip, value, code = self._kernel.solve_one(table, target, load_n,
+                                                       allow_extrapolation)
+            if code < 0 or code >= 4:
+                self._outcome(code, quantity, table, load_n, target)
+            return SlipSolution.of(np.array(slip), np.array(value), _STATUS_0D[STATUS[code]])
         shape, (slip, value, _), status = self._many(quantity, target, load_n,
                                                      (soil, wheel, multipass),
                                                      allow_extrapolation, None)
@@ -289,6 +295,13 @@ class WheelPerformanceModule:
         curve's bands at that slip over its slope there, ``u_slip = u_y / |dy/ds|``
         (linearised; NaN where the curve has no uncertainty, inf where the slope is 0; NaN
         slips stay NaN); ``slip`` and ``load_n`` broadcast together."""
+        if isinstance(slip, (float, int)) and isinstance(load_n, (float, int)):
+            table = self._table(quantity, soil, wheel, multipass)
+            conf, pred, code = self._kernel.slip_band_one(table, slip, load_n,
+                                                          allow_extrapolation)
+            if code:
+                self._outcome(code, quantity, table, load_n, slip, "slip")
+            return np.float64(conf), np.float64(pred)
         shape, (_, conf, pred), _ = self._many(quantity, slip, load_n,
                                                (soil, wheel, multipass), allow_extrapolation,
                                                "SLIP_BANDS")
