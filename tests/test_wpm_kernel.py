@@ -148,12 +148,12 @@ def test_the_inverse_at_random_loads_is_the_smallest_root_within_1e_9(wpm, quant
         else:
             t = float(rng.uniform(values.min() - 0.1 * span, values.max() + 0.1 * span))
         targets.append(t)
-        expected.append((_reference_inverse(curve, t), np.max(np.abs(values)), span))
+        expected.append((_reference_inverse(curve, t), np.max(np.abs(values))))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LoadExtrapolationWarning)
         vector = wpm.slip_for(quantity, targets, loads, multipass=0, allow_extrapolation=True)
         checked = 0
-        for i, ((slip, value, status, margin), scale, span) in enumerate(expected):
+        for i, ((slip, value, status, margin), scale) in enumerate(expected):
             one = wpm.slip_for_one(quantity, targets[i], loads[i], multipass=0,
                                    allow_extrapolation=True)
             assert one == (float(vector.slip[i]), float(vector.value[i]),
@@ -171,6 +171,30 @@ def test_the_inverse_at_random_loads_is_the_smallest_root_within_1e_9(wpm, quant
     assert checked > 140 and {"ok", "above_max", "below_min"} <= statuses
     if stepped and quantity == "dp_n":  # DP rises through its jump: at_step
         assert "at_step" in statuses
+
+
+@pytest.mark.parametrize("quantity", ["dp_n", "sinkage_m"])
+def test_slip_bands_at_random_loads_are_the_value_bands_over_the_slope(wpm, quantity):
+    """``slip_band``: the reference curve's bands over ``|dy/ds|`` there (docs/wpm-csv.md,
+    "Uncertainty"), within 1e-9 relative, scalar and arrays alike; NaN slips stay NaN."""
+    rng = np.random.default_rng(13)
+    loads, lo, hi = _queries(wpm, rng, 60)
+    loads = np.clip(loads, lo, hi)
+    slips = rng.uniform(-0.1, 0.6, loads.size)
+    reference = _reference_curves(wpm, quantity, loads)
+    conf, pred = wpm.slip_band(quantity, slips, loads, multipass=0)
+    for i in range(loads.size):
+        curve = reference.curve(i)
+        _, c, p = band(curve, slips[i])
+        a = np.array(curve.coefficients)
+        slope = abs(horner(a[1:] * np.arange(1, a.size), slips[i])
+                    + (curve.slope_below_zero if slips[i] < 0 else 0.0))
+        assert conf[i] == pytest.approx(c / slope, rel=RELATIVE)
+        assert pred[i] == pytest.approx(p / slope, rel=RELATIVE)
+        one = wpm.slip_band(quantity, float(slips[i]), float(loads[i]), multipass=0)
+        assert (float(one[0]), float(one[1])) == (conf[i], pred[i])
+    nan = wpm.slip_band(quantity, [np.nan, 0.2], 150.0, multipass=0)
+    assert np.isnan(nan[0][0]) and np.isfinite(nan[0][1])
 
 
 def test_scalar_and_array_inverse_agree_on_repeated_and_fresh_loads(wpm):
