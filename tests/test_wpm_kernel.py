@@ -22,7 +22,7 @@ import pytest
 from fitting import (LoadExtrapolationWarning, LoadRangeError, band, fit_results,
                      interpolate_loads)
 from fitting.polynomial import horner
-from wpm_export import (WheelPerformanceModule, WpmFormatError, WpmSelectionError,
+from wpm_export import (WheelPerformanceModule, WpmCurve, WpmFormatError, WpmSelectionError,
                         inputs_sha256, write_wpm_csv)
 from test_fitting_synthetic import model_results_table
 
@@ -195,6 +195,31 @@ def test_slip_bands_at_random_loads_are_the_value_bands_over_the_slope(wpm, quan
         assert (float(one[0]), float(one[1])) == (conf[i], pred[i])
     nan = wpm.slip_band(quantity, [np.nan, 0.2], 150.0, multipass=0)
     assert np.isnan(nan[0][0]) and np.isfinite(nan[0][1])
+
+
+def test_read_only_arrays_are_answered(wpm):
+    """Arrays from pandas (copy-on-write) or broadcasting are read-only views."""
+    slips, loads = np.array([0.1, 0.3]), np.array([100.0, 200.0])
+    slips.flags.writeable = loads.flags.writeable = False
+    expected = wpm.at_slip(slips.copy(), loads.copy(), multipass=0)
+    np.testing.assert_array_equal(wpm.at_slip(slips, loads, multipass=0)["dp_n"],
+                                  expected["dp_n"])
+    found = wpm.slip_for("dp_n", slips * 50, loads, multipass=0)
+    assert found.reached.all()
+
+
+def test_curves_without_uncertainty_give_nan_bands_and_their_values():
+    """A file without the uncertainty columns (older swtlab, other tools): unknown, not 0."""
+    rows = [WpmCurve((1.0 * k, 100.0, -50.0, 10.0), -0.2, 0.6, soil="s", wheel="w",
+                     multipass=0, load_n=load, quantity="dp_n", unit="N", n_points=8, rmse=0.0,
+                     line=3, step_below_zero=-2.0, slope_below_zero=5.0)
+            for k, load in enumerate((100.0, 200.0, 300.0))]
+    wpm = WheelPerformanceModule(rows)
+    value, conf, pred = wpm.band_one("dp_n", -0.1, 150.0)
+    expected = interpolate_loads({c.load_n: c for c in rows}, [150.0]).curve(0)
+    assert value == pytest.approx(float(expected.evaluate(-0.1)), rel=RELATIVE)
+    assert np.isnan(conf) and np.isnan(pred)
+    assert np.isnan(wpm.slip_band("dp_n", 0.2, 150.0)).all()
 
 
 def test_scalar_and_array_inverse_agree_on_repeated_and_fresh_loads(wpm):

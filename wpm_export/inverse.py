@@ -60,16 +60,16 @@ def solve_slip(coefficients, row, target, slip_min: float, slip_max: float,
     for a non-finite target."""
     from wpm_export import kernel
 
-    coefficients = np.ascontiguousarray(np.atleast_2d(np.asarray(coefficients, dtype=float)))
+    coefficients = np.array(np.atleast_2d(np.asarray(coefficients, dtype=float)))
     if coefficients.shape[1] - 1 > kernel.MAX_DEGREE:
         raise ValueError(f"coefficients: degree {coefficients.shape[1] - 1} above "
                          f"{kernel.MAX_DEGREE}")
-    row = np.ascontiguousarray(np.asarray(row, dtype=np.int64).ravel())
-    target = np.ascontiguousarray(np.asarray(target, dtype=float).ravel())
+    row = np.array(np.asarray(row, dtype=np.int64).ravel())  # contiguous, writable
+    target = np.array(np.asarray(target, dtype=float).ravel())
     if not np.all(np.isfinite(target)):
         raise ValueError("target: targets must be finite numbers")
     branch = np.zeros((coefficients.shape[0], 2)) if below_zero is None else \
-        np.ascontiguousarray(np.asarray(below_zero, dtype=float).reshape(-1, 2))
+        np.array(np.asarray(below_zero, dtype=float).reshape(-1, 2))
     slip, value = np.empty(target.size), np.empty(target.size)
     status = np.empty(target.size, dtype=np.int8)
     kernel.solve_rows(coefficients, branch, row, target, float(slip_min), float(slip_max),

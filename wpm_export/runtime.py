@@ -184,7 +184,7 @@ class WheelPerformanceModule:
         x, load = np.broadcast_arrays(np.asarray(x, dtype=float),
                                       np.asarray(load_n, dtype=float))
         shape = x.shape
-        x, load = np.ascontiguousarray(x.ravel()), np.ascontiguousarray(load.ravel())
+        x, load = np.array(x.ravel()), np.array(load.ravel())  # contiguous, writable copies
         out = np.empty(x.size), np.empty(x.size), np.empty(x.size)
         status = np.empty(x.size, dtype=np.int8) if mode is None else None
         if mode is None:
