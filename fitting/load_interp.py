@@ -196,12 +196,73 @@ class LoadPolynomial:
         self.slip_min, self.slip_max = setup.slip_min, setup.slip_max
         to_theta = setup.projection @ solution_to_parameters(
             setup.slip_min, setup.slip_max, setup.degree, setup.projection.shape[1])
+        self._setup, self._to_theta = setup, to_theta
         self._at_tested = setup.values @ to_theta  # tested loads x p
         if setup.tested.size >= 2 and setup.method == "pchip":
             pieces = PchipInterpolator(setup.tested, setup.values, axis=0).c  # 4 x L-1 x grid
             self._pieces = pieces @ to_theta  # 4 x L-1 x p: cubic in (load - tested[k])
         else:
             self._pieces = None
+
+    @property
+    def at_tested(self) -> np.ndarray:
+        """Parameters at the tested loads (tested loads x p)."""
+        return self._at_tested
+
+    @property
+    def pieces(self) -> np.ndarray | None:
+        """PCHIP pieces of the parameters (4 x L-1 x p; row 0 the cubic term, in
+        ``load - tested[k]``), None for linear interpolation."""
+        return self._pieces
+
+    def spread_at_tested(self) -> np.ndarray:
+        """``(scatter_sd, k95)`` of each tested curve (tested loads x 2; linear across load
+        as in :func:`interpolate_loads`)."""
+        return np.array([[c.scatter_sd, c.k95] for c in self._setup.ordered])
+
+    def covariance_pieces(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The covariance of :func:`interpolate_loads` (``uncertainty=True``) as a polynomial
+        of load: ``(inside, ends)``. ``inside`` (L-1 x 7 x p x p) holds the coefficients of
+        ``t**r`` (r = 0..6, ``t = (load - tested[k]) / (tested[k+1] - tested[k])``) between
+        tested loads ``k`` and ``k+1``: the propagated tested covariances
+        (:func:`_propagate`: its forward-difference sensitivities are cubic in load, their
+        products sextic) plus the interpolation error (:func:`_interpolation_error`). ``ends``
+        (L x p x p): each tested curve's covariance mapped to the parameters, ``D_k``;
+        outside the tested loads (linear extrapolation from ``k``, ``k+1``) the covariance is
+        ``(1 - t)**2 D_k + t**2 D_k+1``. None when a tested curve carries no covariance."""
+        setup, to_theta = self._setup, self._to_theta
+        if not all(c.covariance is not None for c in setup.ordered):
+            return None
+        tested, values, p = setup.tested, setup.values, to_theta.shape[1]
+        mapped = [parameter_gradient(setup.grid, c.degree).T for c in setup.ordered]
+        ends = np.array([(m @ to_theta).T @ np.asarray(c.covariance) @ (m @ to_theta)
+                         for m, c in zip(mapped, setup.ordered)])
+        inside = np.zeros((max(tested.size - 1, 0), 7, p, p))
+        if tested.size < 2:
+            return inside, ends
+        width = np.diff(tested)[:, None]  # dx = t * width
+        powers = width ** np.arange(4)[::-1, None, None]  # c[m] dx**(3-m): w**(3-m) t**(3-m)
+        linear = _linear_pieces(tested, values)
+        base = PchipInterpolator(tested, values, axis=0).c if setup.method == "pchip" else linear
+        delta = _bump(values)
+        for k, c in enumerate(setup.ordered):
+            bumped = values.copy()
+            bumped[k] += delta
+            again = (PchipInterpolator(tested, bumped, axis=0).c if setup.method == "pchip"
+                     else _linear_pieces(tested, bumped))
+            sensitivity = ((again - base) / delta * powers)[::-1]  # t**0 ... t**3 x L-1 x grid
+            a = np.einsum("ig,jkg,gb->kjib", mapped[k], sensitivity, to_theta)  # L-1 x 4 x pk x p
+            cov = np.asarray(c.covariance)
+            for j in range(4):
+                for jj in range(4):
+                    inside[:, j + jj] += np.einsum("kia,ij,kjb->kab", a[:, j], cov, a[:, jj])
+        if tested.size >= 3:  # interpolation error: v v^T / 3, v = (PCHIP - linear) -> theta
+            pchip = PchipInterpolator(tested, values, axis=0).c
+            v = np.einsum("jkg,gb->kjb", ((pchip - linear) * powers)[::-1], to_theta)
+            for j in range(4):
+                for jj in range(4):
+                    inside[:, j + jj] += np.einsum("ka,kb->kab", v[:, j], v[:, jj]) / 3.0
+        return inside, ends
 
     def parameters(self, loads_n, allow_extrapolation: bool = False
                    ) -> tuple[np.ndarray, np.ndarray]:
@@ -275,6 +336,18 @@ def _interpolation_error(tested: np.ndarray, values: np.ndarray, query: np.ndarr
     return np.einsum("qa,qb->qab", v, v) / 3.0
 
 
+def _bump(values: np.ndarray) -> float:
+    """The forward-difference step of :func:`_propagate`: 1e-6 of the values' scale."""
+    return 1e-6 * max(float(np.ptp(values)), float(np.max(np.abs(values))), 1e-300)
+
+
+def _linear_pieces(tested: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Linear interpolation across load as PCHIP's ``.c`` (4 x L-1 x grid, cubic first)."""
+    out = np.zeros((4,) + values[:-1].shape)
+    out[2], out[3] = np.diff(values, axis=0) / np.diff(tested)[:, None], values[:-1]
+    return out
+
+
 def _propagate(ordered: list[PowerCurve], tested: np.ndarray, query: np.ndarray, method: str,
                outside: np.ndarray, grid: np.ndarray, to_theta: np.ndarray) -> np.ndarray:
     """Covariance (queries x p x p) of the interpolated curves' parameters: the tested curves
@@ -284,7 +357,7 @@ def _propagate(ordered: list[PowerCurve], tested: np.ndarray, query: np.ndarray,
     values = np.array([curve_value(c.coefficients, grid, c.step_below_zero, c.slope_below_zero)
                        for c in ordered])
     base = _across_load(tested, values, query, method, outside)
-    delta = 1e-6 * max(float(np.ptp(values)), float(np.max(np.abs(values))), 1e-300)
+    delta = _bump(values)
     out = 0.0
     for k, c in enumerate(ordered):
         bumped = values.copy()

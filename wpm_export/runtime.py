@@ -1,13 +1,15 @@
-"""The Wheel Performance Module at run time: the curve at any load, every quantity at a slip,
-and the slip that gives a required DP, torque, sinkage or resistance (RUAG WPM), from a WPM
-CSV. Loads between the tested ones are interpolated on curve values exactly as in
-:mod:`fitting.load_interp`; all queries are vectorised over numpy arrays.
+"""The Wheel Performance Module at run time: the curve at any load, every quantity at a slip
+with its 95 % bands, and the slip that gives a required DP, torque, sinkage or resistance
+(RUAG WPM), from a WPM CSV. Loads between the tested ones are interpolated on curve values as
+:mod:`fitting.load_interp` documents (docs/wpm-csv.md).
 
-Caches (docs/wpm-csv.md, "Embedding"): per (curve set, quantity) the curves' parameters as
-an exact piecewise polynomial of load (:class:`fitting.load_interp.LoadPolynomial`); per
-(curve set, quantity, load) asked for a second time, the curve there with its uncertainty and
-its monotone inverse table (:class:`wpm_export.inverse_table.InverseTable`). Loads seen once,
-and many loads in one call, go to the row solver (:func:`wpm_export.inverse.solve_slip`).
+Each (curve set, quantity) is packed once, at its first query, into one table
+(:func:`wpm_export.kernel.pack`): the curve parameters and their covariance as exact
+piecewise polynomials of load. Every query, one scalar or arrays of them, at any load, is
+then answered from that table by the compiled kernels of :mod:`wpm_export.kernel` (numba,
+imported at the first query). :meth:`WheelPerformanceModule.curve` alone builds the full
+:class:`fitting.load_interp.InterpolatedCurve` (with its fit diagnostics) from the tested
+curves.
 """
 
 from __future__ import annotations
@@ -17,19 +19,23 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from fitting.band import band
-from fitting.errors import OutsideSlipRangeWarning
-from fitting.load_interp import InterpolatedCurve, LoadCurves, LoadPolynomial, interpolate_loads
-from fitting.polynomial import curve_value, horner
+from fitting.errors import LoadExtrapolationWarning, LoadRangeError, OutsideSlipRangeWarning
+from fitting.load_interp import InterpolatedCurve, LoadPolynomial, interpolate_loads
 from swtlab.domain import Wheel
-from wpm_export.inverse import SlipSolution, solve_slip
-from wpm_export.inverse_table import InverseTable
+from wpm_export.inverse import SlipSolution
 from wpm_export.reader import WpmCurve, read_wpm_csv, wheel_geometry
 from wpm_export.schema import UNITS, WpmSelectionError
 
 CurveSet = tuple[str, str, int]  # (soil, wheel, multipass)
-TABLE_LOADS = 8  # a call with at most this many distinct loads uses (and builds) their tables
-MAX_TABLES = 4096  # cached tables kept (oldest dropped first)
+#: status text by kernel code (status + 4 when the load was extrapolated)
+STATUS = ("ok", "above_max", "below_min", "at_step") * 2
+_STATUS_0D = {s: np.array(s, dtype="<U9") for s in STATUS[:4]}  # shared, read-only
+for _status in _STATUS_0D.values():
+    _status.flags.writeable = False
+
+
+def _selection_text(soil, wheel, multipass) -> str:
+    return f"soil={soil!r}, wheel={wheel!r}, multipass={multipass!r}"
 
 
 class WheelPerformanceModule:
@@ -38,7 +44,8 @@ class WheelPerformanceModule:
     ``load_method``: interpolation across load, ``"auto"`` (PCHIP with 3+ tested loads, else
     linear), ``"linear"`` or ``"pchip"``. Every query takes ``soil``, ``wheel``,
     ``multipass`` to pick the set (needed only when several sets match) and
-    ``allow_extrapolation`` for loads outside the tested ones (warned, linear).
+    ``allow_extrapolation`` for loads outside the tested ones (warned, linear). Bad input
+    raises a one-line error naming the keyword argument (docs/wpm-csv.md, "Errors").
     """
 
     def __init__(self, curves: Iterable[WpmCurve], header: dict[str, str] | None = None,
@@ -47,9 +54,8 @@ class WheelPerformanceModule:
         self.wheels: dict[str, Wheel] = wheel_geometry(self.header, source)
         self._sets: dict[CurveSet, dict[str, dict[float, WpmCurve]]] = {}
         self._polynomials: dict[tuple, LoadPolynomial] = {}
-        self._tables: dict[tuple, tuple[InverseTable, InterpolatedCurve]] = {}
-        self._seen: set[tuple] = set()
-        self._fast: dict[tuple, tuple[InverseTable, InterpolatedCurve]] = {}
+        self._packed: dict[tuple, np.ndarray] = {}  # (quantity, soil, wheel, multipass) as asked
+        self._kernel = None  # wpm_export.kernel, imported at the first query
         for c in curves:
             by_quantity = self._sets.setdefault((c.soil, c.wheel, c.multipass), {})
             by_quantity.setdefault(c.quantity, {})[c.load_n] = c
@@ -84,18 +90,16 @@ class WheelPerformanceModule:
     def select(self, soil: str | None = None, wheel: str | None = None,
                multipass: int | None = None) -> CurveSet:
         """The one set matching the given fields, else :class:`WpmSelectionError` listing
-        the choices."""
+        the choices as keyword arguments."""
         match = [k for k in self.sets() if (soil is None or k[0] == soil)
                  and (wheel is None or k[1] == wheel) and (multipass is None or k[2] == multipass)]
         if not match:
-            choices = "; ".join(f"--soil {s} --wheel {w} --multipass {m}"
-                                for s, w, m in self.sets())
-            raise WpmSelectionError(f"no curves for soil={soil} wheel={wheel} "
-                                    f"multipass={multipass} in {self.source}; choices: {choices}")
+            choices = "; ".join(_selection_text(*k) for k in self.sets())
+            raise WpmSelectionError(f"no curves for {_selection_text(soil, wheel, multipass)} "
+                                    f"in {self.source}; choices: {choices}")
         if len(match) > 1:
             raise WpmSelectionError(f"{len(match)} curve sets match in {self.source}; pick one: "
-                                    + "; ".join(f"--soil {s} --wheel {w} --multipass {m}"
-                                                for s, w, m in match))
+                                    + "; ".join(_selection_text(*k) for k in match))
         return match[0]
 
     def quantities(self, **selection) -> list[str]:
@@ -106,107 +110,161 @@ class WheelPerformanceModule:
     def _by_load(self, quantity: str, selection: dict) -> dict[float, WpmCurve]:
         key = self.select(**selection)
         if quantity not in self._sets[key]:
-            raise WpmSelectionError(f"no {quantity} curves for {key} in {self.source}; it has "
+            raise WpmSelectionError(f"quantity={quantity!r}: no such curves for "
+                                    f"{_selection_text(*key)} in {self.source}; it has "
                                     + ", ".join(self.quantities(**selection)))
         return self._sets[key][quantity]
 
-    def _curves_at(self, quantity: str, loads_n, selection: dict, allow_extrapolation: bool,
-                   uncertainty: bool = False) -> tuple[LoadCurves, np.ndarray]:
-        """Curves at the distinct loads of ``loads_n`` and the index of each load's curve
-        (with their covariance only when ``uncertainty``: it costs per load)."""
-        unique, inverse = np.unique(np.asarray(loads_n, dtype=float).ravel(), return_inverse=True)
-        curves = interpolate_loads(self._by_load(quantity, selection), unique,
-                                   method=self.load_method,
-                                   allow_extrapolation=allow_extrapolation,
-                                   uncertainty=uncertainty)
-        return curves, inverse
+    def _polynomial(self, quantity: str, selection: dict) -> LoadPolynomial:
+        key = (self.select(**selection), quantity)
+        if key not in self._polynomials:
+            self._polynomials[key] = LoadPolynomial(self._by_load(quantity, selection),
+                                                    method=self.load_method)
+        return self._polynomials[key]
+
+    def _table(self, quantity: str, soil, wheel, multipass) -> np.ndarray:
+        """The packed table of a quantity of the selected set (built at its first query)."""
+        table = self._packed.get((quantity, soil, wheel, multipass))
+        if table is None:
+            if self._kernel is None:
+                from wpm_export import kernel
+                self._kernel = kernel
+            selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
+            table = self._kernel.pack(self._polynomial(quantity, selection))
+            self._packed[(quantity, soil, wheel, multipass)] = table
+        return table
+
+    def _tested(self, table: np.ndarray) -> np.ndarray:
+        first = int(table[self._kernel.TESTED])
+        return table[first:first + int(table[self._kernel.LOADS])]
+
+    def _outcome(self, code: int, quantity: str, table: np.ndarray, load_n, value=None,
+                 name: str = "target", count: int = 1) -> None:
+        """Raise for an error code of the kernel (the message names the keyword argument),
+        else warn that ``count`` loads were extrapolated."""
+        k, tested = self._kernel, self._tested(table)
+        span = f"{tested[0]:g}-{tested[-1]:g} N" if tested.size > 1 else f"{tested[0]:g} N"
+        if code == k.BAD_TARGET or code == k.BAD_SLIP:
+            raise ValueError(f"{name}={value!r}: {quantity} queries need a finite number")
+        if code == k.BAD_LOAD:
+            raise LoadRangeError(f"load_n={load_n!r}: the wheel load must be a finite number "
+                                 "> 0 N")
+        if code == k.ONE_LOAD:
+            raise LoadRangeError(f"load_n={load_n:g} N: {quantity} was tested at {span} only, "
+                                 "nothing to interpolate from")
+        if code == k.OUTSIDE:
+            raise LoadRangeError(f"load_n={load_n:g} N is outside the tested loads ({span}) of "
+                                 f"{quantity}; pass allow_extrapolation=True to extrapolate "
+                                 "linearly from the two nearest loads")
+        warnings.warn(f"{count} load(s) outside the tested loads ({span}) of {quantity}, e.g. "
+                      f"load_n={load_n:g} N: extrapolated linearly", LoadExtrapolationWarning,
+                      stacklevel=3)
 
     def curve(self, quantity: str, load_n: float, *, soil=None, wheel=None, multipass=None,
               allow_extrapolation: bool = False) -> InterpolatedCurve:
-        """The ``quantity`` curve at ``load_n`` (N), with its bands (:func:`fitting.band`)."""
+        """The ``quantity`` curve at ``load_n`` (N), with its bands (:func:`fitting.band`) and
+        the diagnostics of its refit (:func:`fitting.interpolate_loads`)."""
+        table = self._table(quantity, soil, wheel, multipass)
+        code = self._kernel.value_one(table, 0.0, float(load_n), bool(allow_extrapolation))[3]
+        if code < 0 or code >= self._kernel.EXTRAPOLATED:
+            self._outcome(code, quantity, table, load_n)
         selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
-        return self._curves_at(quantity, [load_n], selection, allow_extrapolation,
-                               uncertainty=True)[0].curve(0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", LoadExtrapolationWarning)
+            return interpolate_loads(self._by_load(quantity, selection), [load_n],
+                                     method=self.load_method,
+                                     allow_extrapolation=allow_extrapolation).curve(0)
+
+    def _many(self, quantity: str, x, load_n, selection: tuple, allow: bool, mode: str | None):
+        """The kernel over ``x`` (targets, or slips with ``mode``: VALUES, BANDS, SLIP_BANDS
+        of :func:`wpm_export.kernel.values_many`) and ``load_n`` broadcast: (shape, three
+        output arrays, status codes of the inverse)."""
+        table = self._table(quantity, *selection)
+        k = self._kernel
+        x, load = np.broadcast_arrays(np.asarray(x, dtype=float),
+                                      np.asarray(load_n, dtype=float))
+        shape = x.shape
+        x, load = np.array(x.ravel()), np.array(load.ravel())  # contiguous, writable copies
+        out = np.empty(x.size), np.empty(x.size), np.empty(x.size)
+        status = np.empty(x.size, dtype=np.int8) if mode is None else None
+        if mode is None:
+            code, at, extrapolated = k.solve_many(table, x, load, bool(allow), out[0], out[1],
+                                                  status)
+        else:
+            code, at, extrapolated = k.values_many(table, x, load, bool(allow), *out,
+                                                   getattr(k, mode))
+        if code:
+            self._outcome(code, quantity, table, float(load[at]), float(x[at]),
+                          "target" if mode is None else "slip")
+        if extrapolated:
+            tested = self._tested(table)
+            outside = load[(load < tested[0]) | (load > tested[-1])]
+            self._outcome(k.EXTRAPOLATED, quantity, table, float(outside[0]),
+                          count=extrapolated)
+        return shape, out, status
 
     def at_slip(self, slip, load_n, *, soil=None, wheel=None, multipass=None,
                 allow_extrapolation: bool = False) -> dict[str, np.ndarray]:
         """Every quantity of the set at ``slip`` and ``load_n`` (broadcast together); warns
         with :class:`OutsideSlipRangeWarning` for slips outside a curve's range."""
-        selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
-        slip, load = np.broadcast_arrays(np.asarray(slip, dtype=float),
-                                         np.asarray(load_n, dtype=float))
+        selection = (soil, wheel, multipass)
         out, outside = {}, []
-        for q in self.quantities(**selection):
-            curves, index = self._curves_at(q, load, selection, allow_extrapolation)
-            if np.any((slip < curves.slip_min) | (slip > curves.slip_max)):
-                outside.append(f"{q} [{curves.slip_min:g}, {curves.slip_max:g}]")
-            step, slope = curves.below_zero[index].T if curves.below_zero.any() else (0.0, 0.0)
-            out[q] = curve_value(curves.coefficients[index], slip.ravel(), step,
-                                 slope).reshape(slip.shape)
+        for q in self.quantities(soil=soil, wheel=wheel, multipass=multipass):
+            shape, (value, _, _), _ = self._many(q, slip, load_n, selection,
+                                                 allow_extrapolation, "VALUES")
+            table = self._table(q, *selection)
+            lo, hi = table[self._kernel.SLIP_MIN], table[self._kernel.SLIP_MAX]
+            if np.any((np.asarray(slip) < lo) | (np.asarray(slip) > hi)):
+                outside.append(f"{q} [{lo:g}, {hi:g}]")
+            out[q] = value.reshape(shape)
         if outside:
             warnings.warn("slip outside the range of " + ", ".join(outside) + ": extrapolated",
                           OutsideSlipRangeWarning, stacklevel=2)
         return out
 
-    def _polynomial(self, quantity: str, selection: dict) -> tuple[tuple, LoadPolynomial]:
-        key = (self.select(**selection), quantity)
-        if key not in self._polynomials:
-            self._polynomials[key] = LoadPolynomial(self._by_load(quantity, selection),
-                                                    method=self.load_method)
-        return key, self._polynomials[key]
+    def band(self, quantity: str, slip, load_n, *, soil=None, wheel=None, multipass=None,
+             allow_extrapolation: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(value, conf_half95, pred_half95)`` of ``quantity`` at ``slip`` and ``load_n``
+        (broadcast together), as :func:`fitting.band` of :meth:`curve` gives them: the 95 %
+        half-widths of the true curve and of one new run's mean (NaN where the file carries
+        no uncertainty). No warning outside the fitted slip range."""
+        shape, out, _ = self._many(quantity, slip, load_n, (soil, wheel, multipass),
+                                   allow_extrapolation, "BANDS")
+        return tuple(a.reshape(shape) for a in out)
 
-    def _table(self, key: tuple, quantity: str, load_n: float, selection: dict,
-               allow_extrapolation: bool, build: bool):
-        """The cached (inverse table, curve) at one load, built when ``build`` (else None if
-        not cached); the load checked (and warned about) on every call."""
-        entry = self._tables.get((key, load_n))
-        if entry is None:
-            if not build:
-                return None
-            curve = self.curve(quantity, load_n, **selection,
-                               allow_extrapolation=allow_extrapolation)
-            entry = (InverseTable(curve.coefficients, curve.slip_min, curve.slip_max,
-                                  curve.step_below_zero, curve.slope_below_zero), curve)
-            if len(self._tables) >= MAX_TABLES:
-                del self._tables[next(iter(self._tables))]
-            self._tables[(key, load_n)] = entry
-        elif entry[1].extrapolated:
-            self._polynomials[key].parameters([load_n], allow_extrapolation)  # raise or warn
-        return entry
+    def band_one(self, quantity: str, slip: float, load_n: float, *, soil=None, wheel=None,
+                 multipass=None, allow_extrapolation: bool = False
+                 ) -> tuple[float, float, float]:
+        """:meth:`band` of one slip at one load as floats: the call a simulator makes each
+        time step."""
+        table = self._packed.get((quantity, soil, wheel, multipass))
+        if table is None:
+            table = self._table(quantity, soil, wheel, multipass)
+        try:
+            value, conf, pred, code = self._kernel.value_one(table, slip, load_n,
+                                                             allow_extrapolation)
+        except TypeError:
+            raise TypeError(f"slip={slip!r}, load_n={load_n!r}: numbers expected") from None
+        if code:
+            self._outcome(code, quantity, table, load_n, slip, "slip")
+        return value, conf, pred
 
     def slip_for_one(self, quantity: str, target: float, load_n: float, *, soil=None,
                      wheel=None, multipass=None, allow_extrapolation: bool = False
                      ) -> tuple[float, float, str]:
         """:meth:`slip_for` of one target at one load as ``(slip, value, status)`` floats and
-        text: the call a simulator makes in its loop (the load's table is built the second
-        time the load is asked for, then every call is a table look-up)."""
-        fast = self._fast.get((quantity, soil, wheel, multipass, load_n))
-        if fast is not None and not fast[1].extrapolated and target - target == 0.0:
-            return fast[0].solve(target)
-        selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
-        key, polynomial = self._polynomial(quantity, selection)
-        load_n, target = float(load_n), float(target)
-        if target - target != 0.0:
-            raise ValueError("targets must be finite numbers")
-        seen = (key, load_n) in self._seen
-        entry = self._table(key, quantity, load_n, selection, allow_extrapolation, seen)
-        if entry is None:
-            self._seen.add((key, load_n))
-            found = self._rows(polynomial, [target], [load_n], allow_extrapolation)
-            return float(found.slip[0]), float(found.value[0]), str(found.status[0])
-        if len(self._fast) >= MAX_TABLES:
-            del self._fast[next(iter(self._fast))]
-        self._fast[(quantity, soil, wheel, multipass, load_n)] = entry
-        return entry[0].solve(target)
-
-    @staticmethod
-    def _rows(polynomial: LoadPolynomial, target, load, allow_extrapolation: bool
-              ) -> SlipSolution:
-        unique, index = np.unique(np.asarray(load, dtype=float), return_inverse=True)
-        theta, _ = polynomial.parameters(unique, allow_extrapolation)
-        degree = polynomial.degree
-        return solve_slip(theta[:, :degree + 1], index, target, polynomial.slip_min,
-                          polynomial.slip_max, theta[:, degree + 1:])
+        text: the call a simulator makes each time step, at whatever load."""
+        table = self._packed.get((quantity, soil, wheel, multipass))
+        if table is None:
+            table = self._table(quantity, soil, wheel, multipass)
+        try:
+            slip, value, code = self._kernel.solve_one(table, target, load_n,
+                                                       allow_extrapolation)
+        except TypeError:
+            raise TypeError(f"target={target!r}, load_n={load_n!r}: numbers expected") from None
+        if code < 0 or code >= 4:
+            self._outcome(code, quantity, table, load_n, target)
+        return slip, value, STATUS[code]
 
     def slip_for(self, quantity: str, target, load_n, *, soil=None, wheel=None, multipass=None,
                  allow_extrapolation: bool = False) -> SlipSolution:
@@ -214,49 +272,37 @@ class WheelPerformanceModule:
         (broadcast together); slip 1.0 and the maximum where the target is above the curve
         (the maximum over the fitted slip range), slip 0.0 and status ``at_step`` where it
         falls inside the jump at zero slip (:mod:`wpm_export.inverse`); ``value`` is the
-        target where it is reached. Exact to 1e-8 in slip (tables) or rounding (rows)."""
-        selection = {"soil": soil, "wheel": wheel, "multipass": multipass}
-        key, polynomial = self._polynomial(quantity, selection)
-        if np.ndim(load_n) == 0:  # one load: its table
-            target = np.asarray(target, dtype=float)
-            if not np.isfinite(target).all():
-                raise ValueError("targets must be finite numbers")
-            table, _ = self._table(key, quantity, float(load_n), selection,
-                                   allow_extrapolation, True)
-            slip, value, status = table.solve_many(target)
-            return SlipSolution(slip=slip, value=value, status=status)
-        target, load = np.broadcast_arrays(np.asarray(target, dtype=float),
-                                           np.asarray(load_n, dtype=float))
-        if not np.all(np.isfinite(target)):
-            raise ValueError("targets must be finite numbers")
-        shape, target, load = target.shape, target.ravel(), load.ravel()
-        unique = np.unique(load)
-        if unique.size > TABLE_LOADS:
-            found = self._rows(polynomial, target, load, allow_extrapolation)
-        else:
-            slip, value = np.empty(target.shape), np.empty(target.shape)
-            status = np.empty(target.shape, dtype="<U9")
-            for w in unique.tolist():
-                at = load == w if unique.size > 1 else slice(None)
-                table, _ = self._table(key, quantity, w, selection, allow_extrapolation, True)
-                slip[at], value[at], status[at] = table.solve_many(target[at])
-            found = SlipSolution(slip=slip, value=value, status=status)
-        return SlipSolution(slip=found.slip.reshape(shape), value=found.value.reshape(shape),
-                            status=found.status.reshape(shape))
+        target where it is reached. Exact to rounding (the root to 1e-14)."""
+        if isinstance(target, (float, int)) and isinstance(load_n, (float, int)):
+            table = self._packed.get((quantity, soil, wheel, multipass))
+            if table is None:
+                table = self._table(quantity, soil, wheel, multipass)
+            slip, value, code = self._kernel.solve_one(table, target, load_n,
+                                                       allow_extrapolation)
+            if code < 0 or code >= 4:
+                self._outcome(code, quantity, table, load_n, target)
+            return SlipSolution.of(np.array(slip), np.array(value), _STATUS_0D[STATUS[code]])
+        shape, (slip, value, _), status = self._many(quantity, target, load_n,
+                                                     (soil, wheel, multipass),
+                                                     allow_extrapolation, None)
+        return SlipSolution(slip=slip.reshape(shape), value=value.reshape(shape),
+                            status=np.array(STATUS[:4], dtype="<U9")[status].reshape(shape))
 
-    def slip_band(self, quantity: str, slip, load_n: float, *, soil=None, wheel=None,
+    def slip_band(self, quantity: str, slip, load_n, *, soil=None, wheel=None,
                   multipass=None, allow_extrapolation: bool = False
                   ) -> tuple[np.ndarray, np.ndarray]:
-        """95 % half-widths ``(confidence, prediction)`` of the slip found for a target at
-        one load: the curve's bands at that slip over its slope there, ``u_slip = u_y /
-        |dy/ds|`` (linearised; NaN where the curve has no uncertainty, inf where the slope
-        is 0; NaN slips stay NaN)."""
-        curve = self.curve(quantity, load_n, soil=soil, wheel=wheel, multipass=multipass,
-                           allow_extrapolation=allow_extrapolation)
-        s = np.asarray(slip, dtype=float)
-        _, conf, pred = band(curve, s)
-        a = np.array(curve.coefficients)
-        slope = horner(a[1:] * np.arange(1, a.size), s) + np.where(
-            s < 0, curve.slope_below_zero, 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return conf / np.abs(slope), pred / np.abs(slope)
+        """95 % half-widths ``(confidence, prediction)`` of the slip found for a target: the
+        curve's bands at that slip over its slope there, ``u_slip = u_y / |dy/ds|``
+        (linearised; NaN where the curve has no uncertainty, inf where the slope is 0; NaN
+        slips stay NaN); ``slip`` and ``load_n`` broadcast together."""
+        if isinstance(slip, (float, int)) and isinstance(load_n, (float, int)):
+            table = self._table(quantity, soil, wheel, multipass)
+            conf, pred, code = self._kernel.slip_band_one(table, slip, load_n,
+                                                          allow_extrapolation)
+            if code:
+                self._outcome(code, quantity, table, load_n, slip, "slip")
+            return np.float64(conf), np.float64(pred)
+        shape, (_, conf, pred), _ = self._many(quantity, slip, load_n,
+                                               (soil, wheel, multipass), allow_extrapolation,
+                                               "SLIP_BANDS")
+        return conf.reshape(shape), pred.reshape(shape)
