@@ -52,17 +52,31 @@ const char *wpm_g(double x, char buffer[32])
 /* Python's repr of a float: the shortest text that reads back to it */
 void wpm_repr(double x, char buffer[40])
 {
-    int precision;
-    if (!isfinite(x)) {
-        wpm_g(x, buffer);
+    int precision, exponent;
+    char digits[40];
+    if (!isfinite(x) || x == 0) {
+        if (x == 0)
+            strcpy(buffer, signbit(x) ? "-0.0" : "0.0");
+        else
+            wpm_g(x, buffer);
         return;
     }
-    for (precision = 1; precision <= 17; ++precision) {
-        snprintf(buffer, 40, "%.*g", precision, x);
-        if (strtod(buffer, NULL) == x)
+    for (precision = 1; precision < 17; ++precision) {
+        snprintf(digits, sizeof digits, "%.*e", precision - 1, x);
+        if (strtod(digits, NULL) == x)
             break;
     }
-    if (!strpbrk(buffer, ".en"))
+    snprintf(digits, sizeof digits, "%.*e", precision - 1, x);
+    exponent = atoi(strchr(digits, 'e') + 1);
+    if (exponent < -4 || exponent >= 16) { /* 1e+16, 1.5e-05 */
+        char *e = strchr(digits, 'e');
+        if (precision == 1 && e[-1] == '.') /* never: %.0e has no point */
+            e[-1] = 'e';
+        strcpy(buffer, digits);
+        return;
+    }
+    snprintf(buffer, 40, "%.*f", precision - 1 - exponent > 0 ? precision - 1 - exponent : 0, x);
+    if (!strchr(buffer, '.'))
         strcat(buffer, ".0");
 }
 
