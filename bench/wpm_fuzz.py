@@ -196,7 +196,7 @@ def write_mutants(seeds: list[str], n: int, seed: int, folder: Path) -> list[Pat
 def build_driver(folder: Path, sanitize: bool = True) -> Path:
     """The fuzz driver compiled with the library's sources (gcc or $CC)."""
     out = folder / "swtwpm_fuzz"
-    flags = ["-std=c99", "-g", "-O1", *(SANITIZE if sanitize else ())]
+    flags = ["-std=c99", "-g", "-O0" if sanitize else "-O2", *(SANITIZE if sanitize else ())]
     subprocess.run([os.environ.get("CC", "gcc"), *flags, f"-I{ROOT / 'libswtwpm'}", "-o",
                     str(out), *map(str, C_SOURCES), str(DRIVER), "-lm"], check=True)
     return out
