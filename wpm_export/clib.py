@@ -71,6 +71,7 @@ def library() -> ctypes.CDLL:
                                 ctypes.POINTER(ctypes.c_longlong)]),
         "swtwpm_select": (i, [p, c, c, ctypes.c_longlong, c, sz]),
         "swtwpm_has_quantity": (i, [p, i, i]),
+        "swtwpm_tested_loads": (i, [p, i, i, dp, i]),
         "swtwpm_wheel_geometry": (i, [p, c, dp, c, sz]),
         "swtwpm_value": (i, [p, i, i, d, d, i, dp, c, sz]),
         "swtwpm_slip_for": (i, [p, i, i, d, d, i, dp, dp, ip, c, sz]),
@@ -149,6 +150,13 @@ class CWheelPerformanceModule:
         if index < 0:
             self._raise(index, message.value.decode())
         return index
+
+    def tested_loads(self, quantity: str = "dp_n", **selection) -> list[float]:
+        """The tested loads (N) of a quantity of the selected set."""
+        loads = (ctypes.c_double * 256)()
+        count = self._lib.swtwpm_tested_loads(self._model, self.select(**selection),
+                                              QUANTITIES.index(quantity), loads, 256)
+        return list(loads[:max(count, 0)])
 
     def wheel_geometry(self, wheel: str | None = None) -> dict[str, float | None]:
         """radius_m, width_m, grouser_count, grouser_height_m, stiffness_n_per_mm (None:
