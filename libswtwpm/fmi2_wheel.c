@@ -169,6 +169,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType,
     }
     w->load_n = NAN;
     w->slip = 0.0;
+    w->multipass = -1; /* any: resources/wpm.csv holds the one set the FMU was made for */
     w->dirty = 1;
     return w;
 }
@@ -209,7 +210,8 @@ EXPORT fmi2Status fmi2Reset(fmi2Component c)
     wheel_fmu *w = c;
     w->load_n = NAN;
     w->slip = 0.0;
-    w->multipass = w->allow_extrapolation = 0;
+    w->multipass = -1;
+    w->allow_extrapolation = 0;
     w->soil[0] = w->wheel[0] = '\0';
     w->dirty = 1;
     return fmi2OK;

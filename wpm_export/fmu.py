@@ -7,6 +7,7 @@ half-widths, answered by libswtwpm (libswtwpm/fmi2_wheel.c) from the CSV embedde
 
 from __future__ import annotations
 
+import csv
 import io
 import uuid
 import zipfile
@@ -93,6 +94,17 @@ def model_description(soil: str, wheel: str, multipass: int, load_n: float,
 """
 
 
+def _one_set(text: str, soil: str, wheel: str, multipass: int) -> str:
+    """The WPM CSV text with the rows of one curve set only (header and comments kept)."""
+    out = []
+    for line in text.splitlines():
+        fields = next(csv.reader([line]), [])
+        if line.startswith("#") or not line.strip() or fields[:2] == ["soil", "wheel"] or (
+                [f.strip() for f in fields[:3]] == [soil, wheel, str(multipass)]):
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def build_fmu(wpm_csv, out, *, soil=None, wheel=None, multipass=None) -> dict:
     """Write the FMU of the one curve set of ``wpm_csv`` matching soil/wheel/multipass to
     ``out`` (atomically); the CSV is read by libswtwpm first (its errors:
@@ -106,7 +118,9 @@ def build_fmu(wpm_csv, out, *, soil=None, wheel=None, multipass=None) -> dict:
         archive.writestr("modelDescription.xml", model_description(
             set_soil, set_wheel, set_multipass, load_n, Path(wpm_csv).read_text()))
         archive.write(library_path(), f"binaries/linux64/{MODEL_IDENTIFIER}.so")
-        archive.write(wpm_csv, "resources/wpm.csv")
+        text = Path(wpm_csv).read_text(encoding="utf-8-sig")
+        archive.writestr("resources/wpm.csv",
+                         _one_set(text, set_soil, set_wheel, set_multipass))
     write_atomically(out, buffer.getvalue())
     return {"fmu": str(out), "soil": set_soil, "wheel": set_wheel, "multipass": set_multipass}
 
