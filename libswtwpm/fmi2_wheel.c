@@ -53,7 +53,7 @@ typedef struct {
     fmi2CallbackFunctions callbacks;
     char *name;
     double load_n, slip, time;
-    int multipass, allow_extrapolation, status, dirty;
+    int multipass, allow_extrapolation, status, dirty, bands_dirty;
     char soil[256], wheel[256];
     double value[N_OUT], conf95[N_OUT], pred95[N_OUT];
 } wheel_fmu;
@@ -71,14 +71,16 @@ static void say(wheel_fmu *w, fmi2Status status, const char *format, ...)
                         status == fmi2OK ? "logAll" : "logStatusError", "%s", text);
 }
 
-/* the outputs at the current inputs: fmi2OK, fmi2Warning or fmi2Error (message logged) */
-static fmi2Status update(wheel_fmu *w)
+/* the outputs at the current inputs (the half-widths only when asked for: they cost a
+ * covariance per load): fmi2OK, fmi2Warning or fmi2Error (message logged) */
+static fmi2Status update(wheel_fmu *w, int bands)
 {
     char msg[1024] = "";
     int set, q, worst = 0;
-    if (!w->dirty)
+    if (!w->dirty && !(bands && w->bands_dirty))
         return w->status < 0 ? fmi2Error : w->status > 0 ? fmi2Warning : fmi2OK;
     w->dirty = 0;
+    w->bands_dirty = !bands;
     for (q = 0; q < N_OUT; ++q)
         w->value[q] = w->conf95[q] = w->pred95[q] = NAN;
     set = swtwpm_select(w->model, *w->soil ? w->soil : NULL, *w->wheel ? w->wheel : NULL,
@@ -92,9 +94,14 @@ static fmi2Status update(wheel_fmu *w)
         int code;
         if (!swtwpm_has_quantity(w->model, set, q))
             continue;
-        code = swtwpm_value_band(w->model, set, q, w->load_n, w->slip,
-                                 w->allow_extrapolation ? SWTWPM_ALLOW_EXTRAPOLATION : 0,
-                                 &w->value[q], &w->conf95[q], &w->pred95[q], msg, sizeof msg);
+        code = bands ? swtwpm_value_band(w->model, set, q, w->load_n, w->slip,
+                                         w->allow_extrapolation ? SWTWPM_ALLOW_EXTRAPOLATION
+                                                                : 0,
+                                         &w->value[q], &w->conf95[q], &w->pred95[q], msg,
+                                         sizeof msg)
+                     : swtwpm_value(w->model, set, q, w->load_n, w->slip,
+                                    w->allow_extrapolation ? SWTWPM_ALLOW_EXTRAPOLATION : 0,
+                                    &w->value[q], msg, sizeof msg);
         if (code < 0) {
             w->status = code;
             for (q = 0; q < N_OUT; ++q)
@@ -223,11 +230,13 @@ EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], si
     wheel_fmu *w = c;
     fmi2Status status = fmi2OK;
     size_t i;
-    int needs_outputs = 0;
-    for (i = 0; i < nvr; ++i)
+    int needs_outputs = 0, needs_bands = 0;
+    for (i = 0; i < nvr; ++i) {
         needs_outputs |= vr[i] >= 10;
+        needs_bands |= vr[i] >= 20;
+    }
     if (needs_outputs)
-        status = update(w);
+        status = update(w, needs_bands);
     for (i = 0; i < nvr; ++i) {
         unsigned r = vr[i];
         if (r == 0)
@@ -276,7 +285,7 @@ EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[],
         if (vr[i] == 2)
             value[i] = w->multipass;
         else if (vr[i] == VR_STATUS) {
-            update(w);
+            update(w, 0);
             value[i] = w->status;
         } else
             return fmi2Error;
