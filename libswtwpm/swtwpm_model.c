@@ -325,8 +325,9 @@ static int build_cells(wpm_quantity *q, int two_sides, wpm_cells *cells)
     }
     for (g = 0; g < cells->points; ++g)
         for (i = 0; i < n; ++i) {
-            cells->power[g * n + i] = pow(cells->grid[g], i);
-            cells->slope_power[g * n + i] = i > 0 ? i * pow(cells->grid[g], i - 1) : 0.0;
+            cells->power[i * cells->points + g] = pow(cells->grid[g], i);
+            cells->slope_power[i * cells->points + g] = i > 0 ? i * pow(cells->grid[g], i - 1)
+                                                              : 0.0;
         }
     return 0;
 }
@@ -883,11 +884,8 @@ int swtwpm_slip_for(const swtwpm *model, int set, int quantity, double load_n, d
         return SWTWPM_E_ARGUMENT;
     *slip = *value = NAN;
     *status = SWTWPM_STATUS_BELOW_MIN;
-    {
-        int code0;
-        if (!quantity_of(model, set, quantity, msg, msg_size, &code0))
-            return code0;
-    }
+    if (!quantity_of(model, set, quantity, msg, msg_size, &code))
+        return code;
     if (!isfinite(target)) {
         wpm_message(msg, msg_size, "targets must be finite numbers");
         return SWTWPM_E_NOT_FINITE;
@@ -905,19 +903,25 @@ int swtwpm_slip_for(const swtwpm *model, int set, int quantity, double load_n, d
     polys[1] = theta;
     n_cells = cells->points - 1;
     jump = two ? cells->count0 : -1;
-    for (g = 0; g < cells->points; ++g) {
-        const double *poly_g = polys[two && g > cells->count0];
-        double sum = 0, slope = 0;
-        for (i = 0; i < n; ++i) {
-            sum += poly_g[i] * cells->power[g * n + i];
-            slope += poly_g[i] * cells->slope_power[g * n + i];
+    for (g = 0; g < cells->points; ++g) /* f = a @ power, d = a @ slope_power, per side */
+        f[g] = d[g] = 0.0;
+    for (i = 0; i < n; ++i) {
+        const double *power = cells->power + i * cells->points;
+        const double *slope_power = cells->slope_power + i * cells->points;
+        int split = two ? cells->count0 + 1 : cells->points;
+        double a0 = polys[0][i], a1 = polys[1][i];
+        for (g = 0; g < split; ++g) {
+            f[g] += a0 * power[g];
+            d[g] += a0 * slope_power[g];
         }
-        f[g] = sum;
-        d[g] = slope;
+        for (g = split; g < cells->points; ++g) {
+            f[g] += a1 * power[g];
+            d[g] += a1 * slope_power[g];
+        }
     }
     for (c = 0; c < n_cells; ++c) {
         x_turn[c] = f_turn[c] = NAN;
-        if (c != jump && sign(d[c]) * sign(d[c + 1]) < 0) {
+        if (c != jump && ((d[c] > 0 && d[c + 1] < 0) || (d[c] < 0 && d[c + 1] > 0))) {
             const double *poly_c = polys[two && c > cells->count0];
             double derivative[SWTWPM_MAX_DEGREE];
             for (i = 1; i < n; ++i)
@@ -927,12 +931,15 @@ int swtwpm_slip_for(const swtwpm *model, int set, int quantity, double load_n, d
         }
     }
     start = f[0];
-    for (c = 0; c < n_cells; ++c) {
-        rise[c] = np_fmax(f[c + 1], f_turn[c]);
-        fall[c] = np_fmin(f[c + 1], f_turn[c]);
-        if (c) {
-            rise[c] = np_max(rise[c - 1], rise[c]);
-            fall[c] = np_min(fall[c - 1], fall[c]);
+    {
+        double up = np_fmax(f[1], f_turn[0]), down = np_fmin(f[1], f_turn[0]);
+        rise[0] = up;
+        fall[0] = down;
+        for (c = 1; c < n_cells; ++c) { /* running extremes, kept in registers */
+            up = np_max(up, np_fmax(f[c + 1], f_turn[c]));
+            down = np_min(down, np_fmin(f[c + 1], f_turn[c]));
+            rise[c] = up;
+            fall[c] = down;
         }
     }
     top = np_max(start, rise[n_cells - 1]);
