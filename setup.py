@@ -10,6 +10,7 @@ SOURCES = sorted(str(p) for p in Path("libswtwpm").glob("*.c"))
 
 setup(ext_modules=[Extension(
     "wpm_export._libswtwpm", sources=SOURCES, include_dirs=["libswtwpm"], libraries=["m"],
+    depends=sorted(str(p) for p in Path("libswtwpm").glob("*.h")),
     # C99; no contraction into FMA, so the arithmetic is the one the Python runtime does
     extra_compile_args=["-std=c99", "-O2", "-ffp-contract=off", "-fvisibility=default"],
 )])
