@@ -69,7 +69,9 @@ def test_a_load_outside_the_tested_ones_stops_with_the_runtimes_message(made):
     messages = []
     inputs = np.array([(0.0, 400.0, 0.2), (1.0, 400.0, 0.2)],
                       dtype=[("time", float), ("load_n", float), ("slip", float)])
-    with pytest.raises(Exception):
+    from fmpy.fmi1 import FMICallException
+
+    with pytest.raises(FMICallException):
         fmpy.simulate_fmu(str(fmu), input=inputs, step_size=0.5, stop_time=1.0,
                           output=["dp_n"],
                           logger=lambda *args: messages.append(args[-1].decode()
