@@ -9,13 +9,15 @@ OUT ?= out
 
 .PHONY: demo test bench sample-data clean system-deps lock
 
-# Debian's venv module is a separate package; install it only where it is missing.
+# Debian's venv module is a separate package, and the C library libswtwpm (built into the
+# package at install) needs a C compiler; install them only where they are missing.
 system-deps:
 	@$(PYTHON) -c "import ensurepip, venv" 2>/dev/null || \
 	  (apt-get update -qq && apt-get install -y -qq python3-venv)
+	@command -v cc >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq gcc libc6-dev)
 
 # Exact versions (with hashes) from requirements.lock, then swtlab itself without resolving.
-$(STAMP): pyproject.toml requirements.lock | system-deps
+$(STAMP): pyproject.toml setup.py requirements.lock $(wildcard libswtwpm/*.c libswtwpm/*.h) | system-deps
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --require-hashes -r requirements.lock
 	$(BIN)/python -m pip install -q --no-deps -e .

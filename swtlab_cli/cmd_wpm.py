@@ -56,6 +56,32 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="answer for a load outside the tested loads (linear, with a warning)")
     q.add_argument("--json", action="store_true", help="one JSON object on standard output")
     q.set_defaults(func=run_query)
+    f = sub.add_parser(
+        "fmu", help="the wheel as an FMI 2.0 co-simulation FMU (docs/wpm-csv.md)",
+        description="Write an FMU of one curve set: inputs wheel load and slip, outputs DP, "
+                    "torque, sinkage, resistance and their 95 %% half-widths, answered by the "
+                    "C library from the embedded WPM CSV (no Python at run time).")
+    f.add_argument("wpm_csv", help="WPM CSV file")
+    f.add_argument("-o", "--output", required=True, help="FMU file to write (e.g. wheel.fmu)")
+    f.add_argument("--soil", help="soil of the curves (needed when the file has several)")
+    f.add_argument("--wheel", help="wheel of the curves (needed when the file has several)")
+    f.add_argument("--multipass", type=int, help="multipass index of the curves")
+    f.set_defaults(func=run_fmu)
+
+
+def run_fmu(args: argparse.Namespace) -> int:
+    from wpm_export import WpmFormatError, WpmSelectionError
+    from wpm_export.fmu import build_fmu
+
+    try:
+        made = build_fmu(args.wpm_csv, args.output, soil=args.soil, wheel=args.wheel,
+                         multipass=args.multipass)
+    except (OSError, WpmFormatError, WpmSelectionError) as exc:
+        print(f"swtlab wpm: {exc}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    print(f"{made['fmu']}: FMI 2.0 co-simulation FMU of {made['wheel']} on {made['soil']}, "
+          f"multipass {made['multipass']}")
+    return exit_codes.OK
 
 
 def _inverse(wpm, args, chosen: dict) -> dict:

@@ -1,0 +1,116 @@
+"""libswtwpm, the C WPM (issue 37.2), in one run:
+
+- scalar queries per second in C at random continuous loads (one call per query, a new load
+  each time, as a simulator asks every step): forward (DP at a slip), inverse (slip for a
+  DP), forward with the 95 % bands; goal >= 5 M/s; beside the Python runtime asked the same
+  way in the same run (``at_slip`` and ``slip_for_one``, one scalar call per query);
+- 10,000 mutated WPM CSVs (:mod:`bench.wpm_fuzz`) through the reader and every query under
+  AddressSanitizer + UBSan: findings (goal 0), files read and refused, and how often the C
+  and the Python reader agree on reading or refusing a file.
+
+The curves: the bb2_sand model's at the sample campaign's loads and slips, fitted by swtlab
+(:func:`bench.bench_wpm._wpm`).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from bench.bench_wpm import _wpm
+from bench.wpm_fuzz import C_SOURCES, ROOT, build_driver, run_driver, seed_texts, write_mutants
+from wpm_export import WpmFormatError, read_wpm_csv
+
+BENCH = ROOT / "libswtwpm" / "tools" / "bench_queries.c"
+GOAL_PER_S = 5e6
+
+
+def _c_rates(path: Path, folder: Path, n: int) -> dict[str, float]:
+    program = folder / "bench_queries"
+    subprocess.run([os.environ.get("CC", "gcc"), "-std=c99", "-O2", "-ffp-contract=off",
+                    f"-I{ROOT / 'libswtwpm'}", "-o", str(program), *map(str, C_SOURCES),
+                    str(BENCH), "-lm"], check=True)
+    out = subprocess.run([str(program), str(path), "0", str(n)], capture_output=True, text=True,
+                         check=True).stdout
+    return {k: float(v) for k, v in (line.split() for line in out.splitlines())}
+
+
+def _python_rates(path: Path, n: int) -> dict[str, float]:
+    from wpm_export import WheelPerformanceModule
+
+    wpm = WheelPerformanceModule.load(path)
+    rng = np.random.default_rng(1)
+    loads, slips, targets = rng.uniform(70, 300, n), rng.uniform(-0.1, 0.6, n), \
+        rng.uniform(-10, 50, n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        start = time.perf_counter()
+        for w, s in zip(loads.tolist(), slips.tolist()):
+            wpm.at_slip(s, w, multipass=0)["dp_n"]
+        forward = n / (time.perf_counter() - start)
+        start = time.perf_counter()
+        for w, t in zip(loads.tolist(), targets.tolist()):
+            wpm.slip_for_one("dp_n", t, w, multipass=0)
+        inverse = n / (time.perf_counter() - start)
+    return {"forward": forward, "inverse": inverse}
+
+
+def _fuzz(path: Path, folder: Path, n: int) -> dict:
+    paths = write_mutants(seed_texts(path.read_text()), n, seed=37, folder=folder)
+    results, exit_code, report = run_driver(build_driver(folder), paths)
+    agree = python_gaps = nul = 0
+    for p, (code, _) in zip(paths, results):
+        try:
+            read_wpm_csv(p)
+            python_reads = True
+        except WpmFormatError:
+            python_reads = False
+        except Exception:  # noqa: BLE001 - the Python reader's own gaps, counted
+            python_gaps += 1
+            continue
+        nul += b"\x00" in p.read_bytes() and python_reads != (code == 0)
+        agree += python_reads == (code == 0)
+    findings = int(exit_code != 0 or "ERROR: AddressSanitizer" in report
+                   or "runtime error" in report or len(results) != len(paths))
+    return {"mutants": n, "findings": findings, "read": sum(c == 0 for c, _ in results),
+            "refused": sum(c < 0 for c, _ in results),
+            "silent": sum(c < 0 and not m for c, m in results),
+            "agree_with_python": agree, "python_reader_crashes": python_gaps,
+            "disagree_nul_byte": int(nul), "report": report[-2000:] if findings else ""}
+
+
+def main(quick: bool = False) -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        wpm = _wpm(folder)
+        path = Path(wpm.source)
+        c = _c_rates(path, folder, 200_000 if quick else 2_000_000)
+        py = _python_rates(path, 300 if quick else 2000)
+        fuzz_folder = folder / "fuzz"
+        fuzz_folder.mkdir()
+        fuzz = _fuzz(path, fuzz_folder, 1000 if quick else 10_000)
+    print(f"{'scalar queries at random loads':34s} {'C /s':>12s} {'Python /s':>12s} "
+          f"{'ratio':>9s}")
+    for kind in ("forward", "inverse"):
+        print(f"{kind:34s} {c[kind]:12,.0f} {py[kind]:12,.0f} {c[kind] / py[kind]:9,.0f}x"
+              f"  (goal >= {GOAL_PER_S:,.0f}/s: {'met' if c[kind] >= GOAL_PER_S else 'NOT met'})")
+    print(f"{'forward with 95 % bands':34s} {c['band']:12,.0f}")
+    print(f"fuzz: {fuzz['mutants']} mutants under ASan+UBSan, {fuzz['findings']} findings; "
+          f"{fuzz['read']} read, {fuzz['refused']} refused ({fuzz['silent']} without a "
+          f"message); C and Python readers agree on {fuzz['agree_with_python']} "
+          f"(Python reader crashed on {fuzz['python_reader_crashes']}, NUL bytes refused by C "
+          f"only: {fuzz['disagree_nul_byte']})")
+    if fuzz["report"]:
+        print(fuzz["report"])
+    return {"c_per_s": c, "python_per_s": py,
+            "ratio": {k: c[k] / py[k] for k in py}, "goal_per_s": GOAL_PER_S, "fuzz": fuzz}
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,251 @@
+"""libswtwpm (the C WPM, through wpm_export.clib) against the Python runtime: 100,000 random
+queries (forward values and the inverse at random continuous loads) and the 95 % bands agree
+within 1e-9; the edges (beyond the maximum, below the minimum, inside the jump at zero slip,
+outside the tested loads) and bad input (another format version, another wheel, NaN queries,
+loads out of range) give the same answers and the same messages; 300 mutated files run
+through the reader and every query under AddressSanitizer + UBSan without a finding.
+
+In-family: the curves come from swtlab's own fit of the bb2_sand model (the writer and the
+runtime are what the C library is held to); the C code shares no code with the Python
+runtime, only the documented method (docs/wpm-csv.md)."""
+
+from __future__ import annotations
+
+import shutil
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fitting import LoadExtrapolationWarning, LoadRangeError, fit_results
+from fitting.band import band
+from fitting.load_interp import interpolate_loads
+from swtlab.domain import Wheel
+from wpm_export import (WheelPerformanceModule, WpmFormatError, WpmSelectionError,
+                        inputs_sha256, read_wpm_csv, write_wpm_csv)
+from wpm_export.clib import CWheelPerformanceModule
+from bench.wpm_fuzz import build_driver, run_driver, seed_texts, write_mutants
+from test_fitting_synthetic import model_results_table
+
+QUERIES = 100_000
+WHEEL = Wheel(radius_m=0.125, width_m=0.112, grouser_count=12, grouser_height_m=0.0092,
+              stiffness_n_per_mm=None, name="bb2")
+RTOL = 1e-9
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory) -> dict[str, Path]:
+    """The full WPM CSV (uncertainty, braked branch, three loads) and its variants."""
+    folder = tmp_path_factory.mktemp("clib")
+    table = model_results_table(multipass=(0, 1), seed=7)
+    full = folder / "wpm.csv"
+    write_wpm_csv(fit_results(table), full, inputs_sha256(table), "test", wheels={"bb2": WHEEL})
+    names = ("full", "no_uncertainty", "no_branch", "no_geometry", "one_load", "two_loads")
+    out = {}
+    for name, text in zip(names, seed_texts(full.read_text())):
+        out[name] = folder / f"{name}.csv"
+        out[name].write_text(text)
+    return out
+
+
+def _scale(path: Path, quantity: str, multipass: int) -> float:
+    """The quantity's value scale: the largest |value| of its tested curves on their range
+    (values cross zero, so their error is relative to this)."""
+    _, curves = read_wpm_csv(path)
+    return max(float(np.max(np.abs(c.evaluate(np.linspace(c.slip_min, c.slip_max, 201)))))
+               for c in curves if c.quantity == quantity and c.multipass == multipass)
+
+
+def _compare(path: Path, n: int, seed: int) -> int:
+    """``n`` forward and ``n`` inverse queries per quantity and multipass at random loads in
+    the tested range: C and Python agree within RTOL; returns the number compared."""
+    py, c = WheelPerformanceModule.load(path), CWheelPerformanceModule(path)
+    rng = np.random.default_rng(seed)
+    compared = 0
+    for _, _, mp in py.sets():
+        for q in py.quantities(multipass=mp):
+            tested = sorted(py._by_load(q, {"soil": None, "wheel": None, "multipass": mp}))
+            lo, hi = py._polynomial(q, {"soil": None, "wheel": None, "multipass": mp})[1]\
+                .slip_min, py._polynomial(q, {"soil": None, "wheel": None,
+                                              "multipass": mp})[1].slip_max
+            loads = rng.uniform(tested[0], tested[-1], n)
+            slips = rng.uniform(lo, hi, n)
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                expected = py.at_slip(slips, loads, multipass=mp)[q]
+                got = c.value(q, slips, loads, multipass=mp)
+            scale = _scale(path, q, mp)
+            np.testing.assert_allclose(got, expected, rtol=0, atol=RTOL * scale)
+            # targets over the curves' values and beyond both ends (above_max, below_min)
+            span = np.ptp(expected)
+            targets = rng.uniform(expected.min() - 0.2 * span, expected.max() + 0.2 * span, n)
+            want = py.slip_for(q, targets, loads, multipass=mp)
+            have = c.slip_for(q, targets, loads, multipass=mp)
+            assert np.array_equal(want.status, have.status)
+            np.testing.assert_allclose(have.slip, want.slip, rtol=0, atol=RTOL)  # NaN == NaN
+            np.testing.assert_allclose(have.value, want.value, rtol=0, atol=RTOL * scale)
+            assert {"ok", "above_max", "below_min"} <= set(want.status.tolist())
+            compared += 2 * n
+    return compared
+
+
+def test_one_hundred_thousand_random_queries_agree_with_the_python_runtime(files):
+    assert _compare(files["full"], QUERIES // 20, seed=1) == QUERIES
+
+
+@pytest.mark.parametrize("variant", ["no_uncertainty", "no_branch", "one_load", "two_loads"])
+def test_every_header_variant_and_load_count_agrees(files, variant):
+    if variant == "one_load":  # one tested load: only that load answers
+        py, c = WheelPerformanceModule.load(files[variant]), CWheelPerformanceModule(
+            files[variant])
+        load = read_wpm_csv(files[variant])[1][0].load_n
+        s = np.linspace(-0.1, 0.6, 50)
+        for q in py.quantities(multipass=0):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                np.testing.assert_allclose(c.value(q, s, load, multipass=0),
+                                           py.at_slip(s, load, multipass=0)[q], rtol=0,
+                                           atol=RTOL * _scale(files[variant], q, 0))
+        return
+    _compare(files[variant], 1000, seed=2)
+
+
+def test_bands_agree_with_the_runtimes_interpolated_covariance(files):
+    path = files["full"]
+    c = CWheelPerformanceModule(path)
+    _, curves = read_wpm_csv(path)
+    rng = np.random.default_rng(3)
+    for mp in (0, 1):
+        for q in ("dp_n", "torque_nm", "sinkage_m", "resistance_n"):
+            by_load = {k.load_n: k for k in curves if k.quantity == q and k.multipass == mp}
+            loads = np.concatenate([rng.uniform(min(by_load), max(by_load), 12),
+                                    sorted(by_load)])
+            expected = interpolate_loads(by_load, loads)
+            for i, load in enumerate(loads):
+                slips = rng.uniform(expected.slip_min, expected.slip_max, 25)
+                mean, conf, pred = band(expected.curve(i), slips)
+                got = c.band(q, slips, load, multipass=mp)
+                assert np.all(conf > 0)
+                np.testing.assert_allclose(got[1], conf, rtol=RTOL)
+                np.testing.assert_allclose(got[2], pred, rtol=RTOL)
+                np.testing.assert_allclose(got[0], mean, rtol=0,
+                                           atol=RTOL * _scale(path, q, mp))
+    # no uncertainty columns: unknown (NaN), not zero, in both
+    unknown = CWheelPerformanceModule(files["no_uncertainty"]).band("dp_n", [0.2], 150.0,
+                                                                    multipass=0)
+    assert np.isnan(unknown[1]).all() and np.isnan(unknown[2]).all()
+
+
+def test_edges_beyond_the_maximum_below_the_minimum_and_inside_the_step(files):
+    path = files["full"]
+    py, c = WheelPerformanceModule.load(path), CWheelPerformanceModule(path)
+    load = 151.5
+    for q in py.quantities(multipass=0):
+        curve = py.curve(q, load, multipass=0)
+        s = np.linspace(curve.slip_min, curve.slip_max, 200_001)
+        values = curve.evaluate(s)
+        top, bottom = values.max(), values.min()
+        found = c.slip_for(q, [top + 1.0, bottom - 1.0], load, multipass=0)
+        assert found.status.tolist() == ["above_max", "below_min"]
+        assert found.slip[0] == 1.0 and np.isnan(found.slip[1])
+        # the extremes over the fitted range (turning points included, and the braked limit
+        # y(0-) at the jump): Python's to RTOL, the dense grid's to its resolution
+        scale = _scale(path, q, 0)
+        np.testing.assert_allclose(found.value, py.slip_for(
+            q, [top + 1.0, bottom - 1.0], [load, load + 1e-9], multipass=0).value, rtol=0,
+            atol=RTOL * scale)
+        resolution = np.max(np.abs(np.diff(values)))
+        assert abs(found.value[0] - top) <= resolution and abs(found.value[1] - bottom) <= \
+            resolution
+        if curve.step_below_zero and curve.slip_min < 0:  # the jump at zero slip
+            below = curve.evaluate(-1e-15)
+            mid = 0.5 * (below + curve.evaluate(0.0))
+            reached_before = np.any(np.diff(np.sign(values[s < 0] - mid)) != 0)
+            step = c.slip_for(q, mid, load, multipass=0)
+            assert step.status == py.slip_for(q, [mid] * 9, np.full(9, load) + np.arange(9)
+                                              * 1e-9, multipass=0).status[0]
+            if not reached_before:
+                assert step.status == "at_step" and step.slip == 0.0 and step.value == mid
+
+
+def _message(call) -> tuple[type, str]:
+    with pytest.raises(Exception) as caught:
+        call()
+    return caught.type, str(caught.value)
+
+
+def test_bad_input_gives_the_same_error_and_message_as_python(files, tmp_path):
+    path = files["full"]
+    py, c = WheelPerformanceModule.load(path), CWheelPerformanceModule(path)
+    cases = [  # (python call, C call)
+        (lambda: py.slip_for("dp_n", 10.0, [400.0] * 9, multipass=0),
+         lambda: c.slip_for("dp_n", 10.0, 400.0, multipass=0)),
+        (lambda: py.at_slip(0.2, 10.0, multipass=0), lambda: c.value("dp_n", 0.2, 10.0,
+                                                                      multipass=0)),
+        (lambda: py.slip_for("dp_n", 10.0, [np.nan] * 9, multipass=0),
+         lambda: c.slip_for("dp_n", 10.0, np.nan, multipass=0)),
+        (lambda: py.slip_for("dp_n", 10.0, [-5.0] * 9, multipass=0),
+         lambda: c.slip_for("dp_n", 10.0, -5.0, multipass=0)),
+        (lambda: py.slip_for("dp_n", np.nan, [150.0] * 9, multipass=0),
+         lambda: c.slip_for("dp_n", np.nan, 150.0, multipass=0)),
+        (lambda: py.slip_for("dp_n", 10.0, 150.0, wheel="other wheel"),
+         lambda: c.slip_for("dp_n", 10.0, 150.0, wheel="other wheel")),
+        (lambda: py.slip_for("dp_n", 10.0, 150.0), lambda: c.slip_for("dp_n", 10.0, 150.0)),
+    ]
+    for python_call, c_call in cases:
+        assert _message(c_call) == _message(python_call)
+    with pytest.warns(LoadExtrapolationWarning, match="extrapolated linearly"):
+        far = c.value("dp_n", 0.2, 330.0, multipass=0, allow_extrapolation=True)
+    with pytest.warns(LoadExtrapolationWarning):
+        assert far == pytest.approx(py.at_slip(0.2, 330.0, multipass=0,
+                                               allow_extrapolation=True)["dp_n"], rel=1e-9)
+    with pytest.raises(LoadRangeError, match="load 400 N outside the tested loads"):
+        c.value("dp_n", 0.2, 400.0, multipass=0)
+    with pytest.raises(WpmSelectionError, match="no curves for soil=None wheel=other"):
+        c.value("dp_n", 0.2, 150.0, wheel="other")
+    # another format version, and a file that is not a WPM CSV at all
+    other = tmp_path / "v2.csv"
+    other.write_text(path.read_text().replace("swtlab-wpm/1", "swtlab-wpm/2"))
+    for bad in (other, files["full"].parent / "missing.csv"):
+        python_error = _message(lambda bad=bad: WheelPerformanceModule.load(bad))
+        c_error = _message(lambda bad=bad: CWheelPerformanceModule(bad))
+        assert issubclass(python_error[0], c_error[0])
+    assert _message(lambda: CWheelPerformanceModule(other)) == _message(
+        lambda: WheelPerformanceModule.load(other))
+    assert "format 'swtlab-wpm/2', this reader reads 'swtlab-wpm/1'" in _message(
+        lambda: CWheelPerformanceModule(other))[1]
+    with pytest.raises(ValueError, match="slips must be finite numbers"):
+        c.value("dp_n", np.nan, 150.0, multipass=0)
+
+
+def test_the_wheel_geometry_header_is_read(files):
+    c = CWheelPerformanceModule(files["full"])
+    expected = WheelPerformanceModule.load(files["full"]).wheel().geometry()
+    assert c.wheel_geometry() == expected
+    with pytest.raises(WpmSelectionError, match="no wheel geometry"):
+        CWheelPerformanceModule(files["no_geometry"]).wheel_geometry()
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc with the sanitizers")
+def test_three_hundred_mutated_files_under_the_sanitizers(files, tmp_path):
+    paths = write_mutants(seed_texts(files["full"].read_text()), 300, seed=11, folder=tmp_path)
+    results, exit_code, report = run_driver(build_driver(tmp_path), paths)
+    assert exit_code == 0 and "ERROR" not in report and "runtime error" not in report, report
+    assert len(results) == len(paths)
+    refused = [(p, m) for p, (code, m) in zip(paths, results) if code < 0]
+    assert all(code in (0, -1) for code, _ in results)  # read, or a format error
+    assert all(m.startswith(f"{p}:") and len(m) > len(str(p)) + 4 for p, m in refused)
+    assert 0.3 * len(paths) < len(refused) < len(paths)  # the mutants break files, not all
+    # the C reader refuses what the Python reader refuses (NUL bytes: refused by C only)
+    for p, (code, _) in zip(paths, results):
+        if b"\x00" in p.read_bytes():
+            continue
+        try:
+            read_wpm_csv(p)
+            python_reads = True
+        except WpmFormatError:
+            python_reads = False
+        except (TypeError, OverflowError):  # the Python reader's hostile-JSON gaps
+            continue
+        assert python_reads == (code == 0), p
