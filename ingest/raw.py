@@ -62,9 +62,11 @@ class FrameIndex:
 
 @dataclass
 class RawRun:
-    """A run as read from its files, before mapping, calibration and checks."""
+    """A run as read from its files, before mapping, calibration and checks; ``cut_short``:
+    why the file looks cut short (``ingest.cut_short``), None for a whole file."""
 
     path: Path
     records: dict[str, dict]
     topics: dict[str, RawTopic]
     frames: dict[str, FrameIndex] = field(default_factory=dict)
+    cut_short: str | None = None

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ingest import derive
+from ingest import cut_short, derive
 from ingest.calibration import subtract_zero, to_canonical
 from ingest.canonical import CANONICAL, DERIVED, MEASURED, SUBSTITUTES, WRENCH_COLUMNS
 from ingest.channel_map import ChannelMap, load_channel_map
@@ -49,6 +49,8 @@ class Run:
     timing: dict[str, StreamTiming] = field(default_factory=dict)
     units: dict[str, str] = field(default_factory=dict)
     channel_map: str = "spec"
+    #: ``"<file>: file ends at t = ... s (cut short?): <why>"`` when the file looks cut short
+    cut_short: str | None = None
 
     @property
     def run_id(self) -> str:
@@ -58,15 +60,29 @@ class Run:
 def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> Run:
     """Read one run: a file or folder of any format ``ingest.formats`` recognises by content
     (MCAP, HDF5, MATLAB, TDMS, ROS bags, CSV run folder), or a text log its channel map
-    describes."""
+    describes. A file cut short is read as far as it goes; the run says so in
+    ``cut_short`` (and a run it leaves unusable, in its IngestError)."""
     path = Path(path)
     cmap = load_channel_map(channel_map)
     if cmap.format == "delimited" and not is_ros_bag(path):
         cmap = cmap.text_log_map()  # a text log has only the stream's channels
     raw = _read_raw(path, cmap)
+    if raw.cut_short is None:
+        return _run(path, cmap, raw, None)
+    end = max((float(t.t_s[-1]) for t in raw.topics.values() if len(t.t_s)), default=None)
+    try:
+        return _run(path, cmap, raw, cut_short.message(path, end, raw.cut_short))
+    except IngestError as exc:
+        raise IngestError(exc.path, exc.channel,
+                          f"{exc.problem}; {cut_short.note(end, raw.cut_short)}") from None
+
+
+def _run(path: Path, cmap: ChannelMap, raw: RawRun, cut: str | None) -> Run:
     for topic, data in raw.topics.items():
         check_topic(path, topic, data)
     problems = _coverage_problems(path, raw, cmap)
+    if cut is not None:
+        problems.append(Problem("error", None, cut))
     provided = {c.column for c in cmap.channels
                 if c.topic in raw.topics and c.field in raw.topics[c.topic].fields}
     records = merged_records(path, raw.records, cmap)
@@ -83,7 +99,7 @@ def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = N
     problems += _frame_problems(raw.frames, metadata)
     return Run(source=path, metadata=metadata, streams=streams, channels=channels,
                problems=problems, derivation=derivation, frames=raw.frames, timing=timing,
-               units=units, channel_map=cmap.name)
+               units=units, channel_map=cmap.name, cut_short=cut)
 
 
 def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:

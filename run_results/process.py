@@ -27,7 +27,7 @@ from run_results.corrections import RigCompliance, corrected_heights, tare_recor
 from run_results.native import native_quantities
 from run_results.phase_average import phase_average, phase_bins
 from run_results.plausibility import plausibility_flags
-from run_results.rest_readings import rest_readings
+from run_results.rest_readings import ends_moving, rest_readings
 from run_results.result import RunResult
 from run_results.stats import QuantityStats, batch_means_se, pitch_batches, quantity_stats
 from run_results.traces import run_traces
@@ -121,7 +121,7 @@ def _frequency(hz: float) -> float | None:
 
 
 def _flags(run, window, oscillation: dict) -> list[str]:
-    flags = []
+    flags = [f for f in (run.cut_short or ends_moving(run),) if f]
     missing = [c for c in FORCE_CHANNELS if not np.isfinite(run.channels[c].to_numpy()).any()]
     if missing:
         flags.append(f"no force channels ({', '.join(missing)}): forces, torque, thrust and "
