@@ -94,6 +94,7 @@ def _run(path: Path, cmap: ChannelMap, raw: RawRun, cut: str | None) -> Run:
     _check_clocks(path, timing)
     problems += _timing_problems(timing)
     channels, derivation = _channel_table(arrays, timing, metadata, provided, problems)
+    derivation.update(_dp_from_hub(cmap, provided))
     streams = {topic: pd.DataFrame(columns, copy=False)  # their own arrays: no copy
                for topic, columns in arrays.items()}
     problems += _frame_problems(raw.frames, metadata)
@@ -143,6 +144,8 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
     """Per topic: native t_s + calibrated, zeroed canonical SI columns (arrays by name)."""
     streams, units = {}, {}
     used = set()
+    zero_of = {(c.topic, c.field): _ZERO_OF[c.column] for c in cmap.channels
+               if c.column in _ZERO_OF}  # dp_n read from a wrench field has that field's zero
     for topic in cmap.topics:
         data = raw.topics.get(topic)
         if data is None:
@@ -155,8 +158,8 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
             used.add((topic, spec.field))
             with np.errstate(over="ignore", invalid="ignore"):
                 values = to_canonical(data.fields[spec.field], spec, cal)
-                if spec.column in _ZERO_OF:
-                    values = subtract_zero(values, metadata.zero.get(_ZERO_OF[spec.column]))
+                if (topic, spec.field) in zero_of:
+                    values = subtract_zero(values, metadata.zero.get(zero_of[topic, spec.field]))
             check_calibrated(raw.path, f"{topic}.{spec.field}", spec.column, values)
             columns[spec.column] = values
             units[spec.column] = spec.unit if cal is None else "SI (swt.calibration)"
@@ -165,6 +168,22 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
         problems.append(Problem("warning", f"{topic}.{fld}",
                                 "swt.calibration names a channel this run does not have"))
     return streams, units
+
+
+#: ``run.derivation["dp_n"]["method"]`` of drawbar pull read from the hub's force channel
+DP_FROM_HUB = "the hub's horizontal force channel (no drawbar-pull cell)"
+
+
+def _dp_from_hub(cmap: ChannelMap, provided: set[str]) -> dict:
+    """``{"dp_n": ...}`` when the map feeds ``dp_n`` from the source field of a wrench column
+    (a rig without a drawbar-pull cell: DP is the hub's horizontal force), else {}."""
+    dp = next((c for c in cmap.channels if c.column == "dp_n"), None)
+    if dp is None or "dp_n" not in provided:
+        return {}
+    hub = [c.column for c in cmap.channels if c.column in WRENCH_COLUMNS.values()
+           and (c.topic, c.field) == (dp.topic, dp.field)]
+    return {"dp_n": {"method": DP_FROM_HUB, "channel": f"{dp.topic}.{dp.field}",
+                     "same_as": hub}} if hub else {}
 
 
 def _check_clocks(path: Path, timing: dict[str, StreamTiming]) -> None:

@@ -14,7 +14,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "inspect", help="show a run as ingest sees it",
         description="Show a run as ingest sees it: metadata, each channel's rate, span, gaps "
-                    "and units, the common time base, and every problem found.")
+                    "and units, the common time base, and every problem found. Exits 3 when "
+                    "the run lacks a channel the stable phase needs (the wheel's or the "
+                    "sled's speed), naming it.")
     parser.add_argument("run", help="a .mcap file, a CSV run folder (run.json), or a file a "
                                     "channel map describes")
     parser.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
@@ -39,5 +41,7 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.flush()
     except BrokenPipeError:  # `swtlab inspect run | head`: the reader left, not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-    return exit_codes.OK
+    for line in data["stable_phase_missing"]:
+        print(f"{args.run}: {line}", file=sys.stderr)
+    return exit_codes.BAD_INPUT if data["stable_phase_missing"] else exit_codes.OK
 
