@@ -41,8 +41,8 @@ def read_ros(path: Path, cmap: ChannelMap) -> RawRun:
         for topic, log_ns, message in _messages(path, bag, set(cmap.topics)):
             samples.add(topic, log_ns, message)
     if not samples.stamps:
-        return RawRun(path=path, records=records, topics={}, cut_short=cut)
-    return RawRun(path=path, records=records,
+        return RawRun(path=path, records={}, topics={}, cut_short=cut)
+    return RawRun(path=path, records={},  # the sidecar's records: read_run merges them
                   topics=samples.raw_topics(_start_ns(path, records, samples.stamps)),
                   cut_short=cut)
 
@@ -90,7 +90,7 @@ def read_ros_rows(path: Path, cmap: ChannelMap) -> RawRun:
         fields = {name: table[:, i] for i, name in enumerate(cmap.columns) if name in wanted}
         t = fields.pop(cmap.time_column)
         topics[cmap.stream] = RawTopic(t_s=(t - t[0]) * cmap.time_scale_s, fields=fields)
-    return RawRun(path=path, records=sidecar_records(path), topics=topics, cut_short=cut)
+    return RawRun(path=path, records={}, topics=topics, cut_short=cut)  # sidecar: read_run
 
 
 class _Samples:

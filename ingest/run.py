@@ -18,7 +18,7 @@ from ingest.errors import IngestError, Problem
 from ingest.formats import is_ros_bag, read_raw_file
 from ingest.metadata import RunMetadata, parse_metadata
 from ingest.raw import FrameIndex, RawRun
-from ingest.records import merged_records
+from ingest.records import merged_records, metadata_form
 from ingest.ros_reader import read_ros_rows
 from ingest.timebase import (DROP_FACTOR, GAP_FACTOR, JITTER_LIMIT, StreamTiming, common_grid,
                              grid_mask, grid_size, stream_timing, to_grid)
@@ -87,7 +87,8 @@ def _run(path: Path, cmap: ChannelMap, raw: RawRun, cut: str | None) -> Run:
                 if c.topic in raw.topics and c.field in raw.topics[c.topic].fields}
     records = merged_records(path, raw.records, cmap)
     metadata, meta_problems = parse_metadata(path, records,
-                                             needs_suspension="suspension_angle_rad" in provided)
+                                             needs_suspension="suspension_angle_rad" in provided,
+                                             form=metadata_form(path, raw.form))
     problems += meta_problems
     arrays, units = _streams(raw, cmap, metadata, problems)
     timing = {topic: stream_timing(columns["t_s"]) for topic, columns in arrays.items()}
@@ -108,10 +109,14 @@ def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:
         raise IngestError(path, None, "no such file or folder")
     if cmap.format == "delimited":
         if is_ros_bag(path):
-            return read_ros_rows(path, cmap)  # the text log's rows recorded in a bag
+            raw = read_ros_rows(path, cmap)  # the text log's rows recorded in a bag
+            raw.form = "rosbag"
+            return raw
         if not path.is_file():
             raise IngestError(path, None, f"channel map {cmap.name} reads one text file per run")
-        return read_delimited(path, cmap)
+        raw = read_delimited(path, cmap)
+        raw.form = "delimited"
+        return raw
     return read_raw_file(path, cmap)
 
 
