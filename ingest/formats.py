@@ -60,8 +60,8 @@ def sniff(path: Path) -> str:
     raise IngestError(path, None, f"not a run: unknown format (first bytes {head[:8]!r}); "
                       "swtlab reads MCAP, HDF5, MATLAB .mat, NI TDMS, ROS 1/2 bags, CSV run "
                       "folders "
-                      "(for a text log pass its channel map, e.g. --channel-map "
-                      "cmu_3d_terramechanics)")
+                      "(for a text log pass its channel map, e.g. "
+                      "channel_map='cmu_3d_terramechanics')")
 
 
 def is_ros_bag(path: Path) -> bool:

@@ -8,6 +8,7 @@ import os
 import sys
 
 from swtlab_cli import exit_codes
+from swtlab_cli.flags import as_flags
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -23,7 +24,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--channel-map", metavar="MAP", default=None,
                         help="channel map: a .toml path or a shipped name (e.g. "
                              "cmu_3d_terramechanics); default: the spec form")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, cli_parser=parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -33,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         data = report(read_run(args.run, args.channel_map))
     except IngestError as exc:
-        print(str(exc), file=sys.stderr)
+        print(as_flags(str(exc), args), file=sys.stderr)
         return exit_codes.BAD_INPUT
     text = json.dumps(data, indent=2, allow_nan=False) if args.json else render_text(data)
     try:

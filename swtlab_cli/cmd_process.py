@@ -32,6 +32,7 @@ from pathlib import Path
 
 from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
+from swtlab_cli.flags import as_flags
 from swtlab_cli.progress import progress
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -66,7 +67,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                             "(e.g. tcp://10.0.0.5:8786; they must see CAMPAIGN at the same "
                             "path); this process stores them (docs/scale-out.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, cli_parser=parser)
 
 
 def _jobs(text: str) -> int:
@@ -101,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
                                    budget=budget_params(args.campaign))
         client = connect(args.dask) if args.dask else None
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
-        print(f"swtlab process: {error}", file=sys.stderr)
+        print(f"swtlab process: {as_flags(str(error), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     parameters = settings.parameters()
     params_hash = params_sha256(parameters)
@@ -172,7 +173,7 @@ def run(args: argparse.Namespace) -> int:
         for line in statuses[status]:
             print(f"  {status}: {line}")
     for line in failed:
-        print(f"  failed: {line}")
+        print(f"  failed: {as_flags(line, args)}")
     for line in missing:
         print(f"  missing: {line}: stored, but no longer in {args.campaign}; its results stay "
               "listed, marked raw_file_missing")

@@ -285,7 +285,7 @@ def test_cli_writes_one_page_per_campaign(small, tmp_path, capsys, fast_timeseri
     assert _cli(["--db", url, "-o", str(tmp_path / "one.html"), "--campaign",
                  "second run-in"]) == 0
     assert "second run-in" in capsys.readouterr().out and (tmp_path / "one.html").is_file()
-    with pytest.raises(LookupError, match="name one with --campaign"):
+    with pytest.raises(LookupError, match="name one with campaign='"):
         write_report(url, tmp_path / "x.html")
 
 

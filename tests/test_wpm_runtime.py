@@ -140,10 +140,10 @@ def test_the_curve_at_a_load_is_interpolated_on_values(wpm):
 
 def test_several_curve_sets_need_a_choice(wpm):
     assert wpm.sets() == [("bb2_sand", "bb2", 0), ("bb2_sand", "bb2", 1)]
-    with pytest.raises(WpmSelectionError, match="2 curve sets match .*pick one: --soil bb2_sand "
-                                                "--wheel bb2 --multipass 0; --soil bb2_sand"):
+    with pytest.raises(WpmSelectionError, match="2 curve sets match .*pick one: soil='bb2_sand', "
+                                                "wheel='bb2', multipass=0; soil='bb2_sand'"):
         wpm.slip_for("dp_n", 25.0, 120.0)
-    with pytest.raises(WpmSelectionError, match="no curves for soil=clay"):
+    with pytest.raises(WpmSelectionError, match="no curves for soil='clay'"):
         wpm.curve("dp_n", 120.0, soil="clay")
     _, rows = read_wpm_csv(wpm.source)
     one_quantity = WheelPerformanceModule([c for c in rows if c.quantity == "dp_n"

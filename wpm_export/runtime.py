@@ -31,6 +31,12 @@ CurveSet = tuple[str, str, int]  # (soil, wheel, multipass)
 TABLE_LOADS = 8  # a call with at most this many distinct loads uses (and builds) their tables
 MAX_TABLES = 4096  # cached tables kept (oldest dropped first)
 
+def _selection(soil, wheel, multipass) -> str:
+    """A curve set as the keyword arguments that select it (``soil='ES-3', wheel='w1',
+    multipass=0``, those given; the command line prints them as its flags)."""
+    given = {"soil": soil, "wheel": wheel, "multipass": multipass}
+    return ", ".join(f"{k}={v!r}" for k, v in given.items() if v is not None)
+
 
 class WheelPerformanceModule:
     """Curves of one or more (soil, wheel, multipass) sets, each at its tested loads.
@@ -88,14 +94,12 @@ class WheelPerformanceModule:
         match = [k for k in self.sets() if (soil is None or k[0] == soil)
                  and (wheel is None or k[1] == wheel) and (multipass is None or k[2] == multipass)]
         if not match:
-            choices = "; ".join(f"--soil {s} --wheel {w} --multipass {m}"
-                                for s, w, m in self.sets())
-            raise WpmSelectionError(f"no curves for soil={soil} wheel={wheel} "
-                                    f"multipass={multipass} in {self.source}; choices: {choices}")
+            choices = "; ".join(_selection(*k) for k in self.sets())
+            raise WpmSelectionError(f"no curves for {_selection(soil, wheel, multipass)} in "
+                                    f"{self.source}; choices: {choices}")
         if len(match) > 1:
             raise WpmSelectionError(f"{len(match)} curve sets match in {self.source}; pick one: "
-                                    + "; ".join(f"--soil {s} --wheel {w} --multipass {m}"
-                                                for s, w, m in match))
+                                    + "; ".join(_selection(*k) for k in match))
         return match[0]
 
     def quantities(self, **selection) -> list[str]:
