@@ -80,6 +80,22 @@ def _jobs(text: str) -> int:
     return jobs
 
 
+def _where(db: str) -> str:
+    """``--db`` as given and, for a SQLite file, the file it resolves to (a relative path
+    under ``sqlite:///`` said to be one)."""
+    from traceability.database import database_file
+
+    found = database_file(db)
+    if found is None:
+        return db
+    path, relative = found
+    if not relative:
+        return f"{db} = {path}"
+    meant = "/" + db.partition(":///")[2]
+    return (f"{db} = {path} (sqlite:/// and a relative path: from the working directory; "
+            f"an absolute path takes four slashes: sqlite:///{meant})")
+
+
 def run(args: argparse.Namespace) -> int:
     import ingest
     from swtlab.pipeline.database import store_one
@@ -182,5 +198,5 @@ def run(args: argparse.Namespace) -> int:
               + (f", not measured in {len(flow_failed)}" if flow_failed else ""))
     for line in flow_failed:
         print(f"  soil flow not measured: {line}")
-    print(f"database: {args.db}  (list the results: swtlab results --db {args.db})")
+    print(f"database: {_where(args.db)}  (list the results: swtlab results --db {args.db})")
     return exit_codes.OK if done + up_to_date else exit_codes.BAD_INPUT
