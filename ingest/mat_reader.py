@@ -31,7 +31,8 @@ def read_mat(path: Path, cmap: ChannelMap, version: str) -> RawRun:
         raise IngestError(path, "swt", "must be a struct of record structs (swt.run.run_id)")
     records: dict[str, dict] = {}
     structs = [(f"swt.{n}", n, r) for n, r in swt.items()]
-    structs += [(n, n, variables[n]) for n in RECORDS if n in variables]  # run.run_id
+    # record structs of their own (run.run_id); a variable of another kind is not ours
+    structs += [(n, n, variables[n]) for n in RECORDS if isinstance(variables.get(n), dict)]
     for where, name, record in structs:
         if not isinstance(record, dict):
             raise IngestError(path, where, "must be a struct of metadata values")

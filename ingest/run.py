@@ -11,7 +11,7 @@ import pandas as pd
 from ingest import cut_short, derive
 from ingest.calibration import subtract_zero, to_canonical
 from ingest.canonical import CANONICAL, DERIVED, MEASURED, SUBSTITUTES, WRENCH_COLUMNS
-from ingest.channel_map import ChannelMap, load_channel_map
+from ingest.channel_map import ChannelMap, ChannelSpec, load_channel_map
 from ingest.checks import check_calibrated, check_topic
 from ingest.delimited_reader import read_delimited
 from ingest.errors import IngestError, Problem
@@ -149,8 +149,8 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
     """Per topic: native t_s + calibrated, zeroed canonical SI columns (arrays by name)."""
     streams, units = {}, {}
     used = set()
-    zero_of = {(c.topic, c.field): _ZERO_OF[c.column] for c in cmap.channels
-               if c.column in _ZERO_OF}  # dp_n read from a wrench field has that field's zero
+    # dp_n read as a wrench column is (same field, same conversion) has that column's zero
+    zero_of = {_conversion(c): _ZERO_OF[c.column] for c in cmap.channels if c.column in _ZERO_OF}
     for topic in cmap.topics:
         data = raw.topics.get(topic)
         if data is None:
@@ -163,8 +163,8 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
             used.add((topic, spec.field))
             with np.errstate(over="ignore", invalid="ignore"):
                 values = to_canonical(data.fields[spec.field], spec, cal)
-                if (topic, spec.field) in zero_of:
-                    values = subtract_zero(values, metadata.zero.get(zero_of[topic, spec.field]))
+                if _conversion(spec) in zero_of:
+                    values = subtract_zero(values, metadata.zero.get(zero_of[_conversion(spec)]))
             check_calibrated(raw.path, f"{topic}.{spec.field}", spec.column, values)
             columns[spec.column] = values
             units[spec.column] = spec.unit if cal is None else "SI (swt.calibration)"
@@ -173,6 +173,12 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
         problems.append(Problem("warning", f"{topic}.{fld}",
                                 "swt.calibration names a channel this run does not have"))
     return streams, units
+
+
+def _conversion(spec: ChannelSpec) -> tuple:
+    """A channel's source field and how it becomes SI: two columns alike here hold the same
+    values."""
+    return spec.topic, spec.field, spec.unit, spec.scale, spec.offset, spec.zero, spec.zero_value
 
 
 #: ``run.derivation["dp_n"]["method"]`` of drawbar pull read from the hub's force channel

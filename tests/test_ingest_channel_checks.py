@@ -93,6 +93,18 @@ def test_dp_from_the_hub_force_channel_says_so(tmp_path):
     assert not any(f.startswith("no force channels") for f in flags)
 
 
+def test_the_hub_zero_tares_dp_only_when_read_alike(tmp_path):
+    """swt.zero.fx is in fx_n's SI values: dp_n read with another scale keeps its own zero."""
+    flipped = SPEC_MAP.replace('topic = "/tether/force"\nfield = "dp"\nunit = "N"',
+                               'topic = "/hub/wrench"\nfield = "fx"\nunit = "N"\nscale = -1.0')
+    assert flipped != SPEC_MAP
+    run = ingest.read_run(SAMPLE, _map(tmp_path, flipped))
+    zero = run.metadata.zero["fx"]
+    assert zero != 0
+    hub = run.streams["/hub/wrench"]
+    np.testing.assert_allclose(hub["dp_n"], -(hub["fx_n"] + zero), rtol=0, atol=1e-12)
+
+
 def test_a_map_without_dp_hints_at_the_hub_channel(tmp_path):
     run = ingest.read_run(SAMPLE, _map(tmp_path, _without("dp_n")))
     flags = [f for f in process_run(run).flags if f.startswith("no force channels")]
