@@ -35,6 +35,7 @@ from sim_gap.hypotheses import OUTSIDE
 from sim_gap.report import READABLE_SCHEMAS, SCHEMA
 from sim_gap.vocabulary import slip_band_labels
 from swtlab.atomic import write_atomically
+from swtlab.rounding import to_decimal_of
 from terramechanics.effects.depth_varying import SUFFIX as DEPTH_VARYING
 from terramechanics.effects.load_varying import SUFFIX as LOAD_VARYING
 from terramechanics.effects.lug_slip_sinkage import SUFFIX as LUG_SLIP_SINKAGE
@@ -310,8 +311,7 @@ def _how_far_blocks(report: dict) -> list[Block]:
         Table(["held-out RMSE"] + [QUANTITIES[k].axis_label for k in keys], rmse,
               numeric=frozenset(range(1, len(keys) + 1)))]
     if report["chosen"] != SOIL_ONLY:
-        rows = [[QUANTITIES[k].label, f"{per[k]['shrink_pct']:.1f}", _interval(per[k])]
-                for k in keys]
+        rows = [[QUANTITIES[k].label, *_shrink(per[k])] for k in keys]
         blocks.append(Table(["quantity", "shrink [%]", "shrink 95 % interval [%]"], rows,
                             numeric=frozenset({1, 2})))
     return blocks + _per_band_blocks(report, keys)
@@ -342,9 +342,15 @@ def _number(quantity, si_value: float | None) -> str:
     return "" if si_value is None else f"{si_value * quantity.scale:.3g}"
 
 
-def _interval(v: dict) -> str:
+def _shrink(v: dict) -> tuple[str, str]:
+    """The shrink and its 95 % interval, both to the decimal the interval's half-width (its
+    expanded uncertainty, two significant digits) supports (GUM 7.2.6; ``swtlab.rounding``)."""
     low, high = v["shrink_pct_ci95"]
-    return "" if low is None or high is None else f"{low:.1f} to {high:.1f}"
+    if low is None or high is None:
+        return to_decimal_of(v["shrink_pct"], None), ""
+    half = (high - low) / 2
+    return (to_decimal_of(v["shrink_pct"], half),
+            f"{to_decimal_of(low, half)} to {to_decimal_of(high, half)}")
 
 
 def _folds_text(folds: list[str]) -> str:

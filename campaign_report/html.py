@@ -21,7 +21,9 @@ dl.meta{display:grid;grid-template-columns:max-content 1fr;gap:2px 14px;margin:.
 dl.meta dt{color:#555}dl.meta dd{margin:0}
 nav{margin:.6em 0 1em}nav a{margin-right:1em}
 table{border-collapse:collapse;font-size:13px;width:100%}table+table{margin-top:1em}
-th,td{border-bottom:1px solid #e3e3e3;padding:3px 6px;text-align:left;vertical-align:top}
+th,td{border-bottom:1px solid #e3e3e3;padding:3px 5px;text-align:left;vertical-align:top}
+tr:has(+tr.reasons) td{border-bottom:none}
+tr.reasons td{padding:0 6px 4px 2.5em;color:#444;font-size:12.5px}
 th{background:#f3f5f8;position:sticky;top:0}td.num{text-align:right;white-space:nowrap}
 tr.flagged td{background:#fff6df}tr.no_stable_phase td,tr.failed td{background:#fde8e8}
 .status{font-weight:600;white-space:nowrap}.status.ok{color:#1a7f37}
@@ -76,13 +78,16 @@ class Drawing:
 @dataclass(frozen=True)
 class Table:
     """Rows of already formatted cells; ``numeric`` columns align right, ``row_classes``
-    style whole rows (e.g. by status), ``html_columns`` hold trusted markup (links)."""
+    style whole rows (e.g. by status), ``html_columns`` hold trusted markup (links);
+    ``row_notes``: a text shown under its row across the whole table (flags and reasons,
+    readable at any width), none where empty."""
 
     header: list[str]
     rows: list[list[str]]
     numeric: frozenset[int] = frozenset()
     row_classes: list[str] = field(default_factory=list)
     html_columns: frozenset[int] = frozenset()
+    row_notes: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -130,6 +135,10 @@ def _table(t: Table) -> str:
             f"{cell if j in t.html_columns else escape(cell)}</td>"
             for j, cell in enumerate(row))
         rows.append(f'<tr class="{escape(css)}">{cells}</tr>')
+        note = t.row_notes[i] if i < len(t.row_notes) else ""
+        if note:
+            rows.append(f'<tr class="{escape(css)} reasons"><td colspan="{len(t.header)}">'
+                        f"{escape(note)}</td></tr>")
     return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>"
 
 

@@ -15,6 +15,7 @@ from campaign_report.extensions import Extension, register
 from campaign_report.html import Image, Note, Section, Table
 from campaign_report.images import to_png
 from campaign_report.style import Palette
+from swtlab.rounding import value_and_u
 
 #: the agreement the RUAG campaign reports between photo and facility slip
 AGREEMENT = 0.01
@@ -51,7 +52,7 @@ def image_slip_section(data: CampaignData, palette: Palette) -> Section | None:
     difference = rows["image_slip_mean"] - rows["slip_mean"]
     worst = float(np.max(np.abs(difference)))
     cells = [[r.run_id, f"{r.load_set_n:g}", f"{100 * r.slip_mean:.2f}",
-              f"{100 * r.image_slip_mean:.2f} ± {100 * r.image_slip_se:.2f}",
+              " ± ".join(value_and_u(r.image_slip_mean, r.image_slip_se, 100.0)),
               f"{100 * d:+.2f}"] for r, d in zip(rows.itertuples(), difference)]
     verdict = "within" if worst < AGREEMENT else "NOT within"
     return Section("image-slip", "Image slip against encoder slip", [

@@ -91,8 +91,9 @@ def write_report(db_url: str, path: str | Path, campaign: str | None = None,
         if not names:
             raise LookupError(f"{db_url}: no processed runs (run swtlab process first)")
         if campaign is None and len(names) > 1:
-            raise LookupError(f"{len(names)} campaigns in {db_url}; name one with --campaign "
-                              f"({', '.join(names)}) or leave it out for one page each")
+            raise LookupError(f"{len(names)} campaigns in {db_url}; name one with "
+                              f"campaign={names[0]!r} ({', '.join(names)}) or leave it out "
+                              "for one page each")
         name = campaign or names[0]
         if name not in names:
             raise LookupError(f"no campaign {name!r} in {db_url}; it has {', '.join(names)}")

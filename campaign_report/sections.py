@@ -12,6 +12,7 @@ from campaign_report.html import Drawing, Heading, Image, Note, Section, Table
 from campaign_report.images import to_png
 from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from run_results.traces import MAX_TRACE_POINTS
+from swtlab.rounding import plain, value_and_u
 from wpm_export import WheelPerformanceModule
 
 RUNS = "runs"
@@ -27,7 +28,7 @@ def run_anchor(index: int) -> str:
 
 
 def _number(value: float | None, scale: float = 1.0, digits: int = 4) -> str:
-    return "" if value is None else f"{value * scale:.{digits}g}"
+    return "" if value is None else plain(value * scale, digits)
 
 
 #: the run table's quantities: (key, short name, unit, display scale, digits of the mean)
@@ -37,10 +38,13 @@ TABLE_QUANTITIES = (("slip", "slip", "%", 100.0, 3), ("dp_n", "DP", "N", 1.0, 4)
 
 
 def _mean_and_u(run: RunRecord, key: str, scale: float, digits: int) -> list[str]:
-    """A quantity's mean and its combined standard uncertainty (empty: no budget)."""
-    u = run.u.get(key)
-    return [_number(run.means.get(key), scale, digits),
-            "" if u is None else f"{u * scale:.2g}"]
+    """A quantity's mean and its combined standard uncertainty, u to two significant digits
+    and the mean to the same decimal (``swtlab.rounding``); without a budget the mean to
+    ``digits`` significant digits and u empty."""
+    mean, u = run.means.get(key), run.u.get(key)
+    if u is None:
+        return [_number(mean, scale, digits), ""]
+    return list(value_and_u(mean, u, scale))
 
 
 def _window(run: RunRecord) -> str:
@@ -54,8 +58,8 @@ def runs_section(data: CampaignData) -> Section:
     header = ["run", "mode", "load [N]", "multipass", "slip set [%]", "velocity [mm/s]",
               "status", "stable window [s]",
               *(h for _, name, unit, _, _ in TABLE_QUANTITIES
-                for h in (f"{name} [{unit}]", f"u({name}) [{unit}]")), "flags and reasons"]
-    rows, classes = [], []
+                for h in (f"{name} [{unit}]", f"u({name}) [{unit}]"))]
+    rows, classes, notes = [], [], []
     for i, run in enumerate(data.runs):
         rows.append([
             f'<a href="#full-{run_anchor(i)}">{escape(run.run_id)}</a>', run.mode,
@@ -63,14 +67,14 @@ def runs_section(data: CampaignData) -> Section:
             _number(run.velocity_mps, 1000.0, 3),
             f'<span class="status {escape(run.status)}">{escape(run.status)}</span>', _window(run),
             *(cell for key, _, _, scale, digits in TABLE_QUANTITIES
-              for cell in _mean_and_u(run, key, scale, digits)),
-            "; ".join(run.flags)])
+              for cell in _mean_and_u(run, key, scale, digits))])
         classes.append(run.status)
+        notes.append("; ".join(run.flags))
     for run_id, stage, reason in data.failed:
         rows.append([escape(run_id), "", "", "", "", "", '<span class="status failed">failed'
-                     '</span>', "none", *[""] * (2 * len(TABLE_QUANTITIES)),
-                     f"{stage} failed: {reason}"])
+                     '</span>', "none", *[""] * (2 * len(TABLE_QUANTITIES))])
         classes.append("failed")
+        notes.append(f"{stage} failed: {reason}")
     counts = {s: sum(r.status == s for r in data.runs) for s in ("ok", "flagged",
                                                                    "no_stable_phase")}
     summary = (f"{len(data.runs) + len(data.failed)} runs: {counts['ok']} ok, "
@@ -82,10 +86,13 @@ def runs_section(data: CampaignData) -> Section:
                  "(the run's uncertainty budget: within-window statistics, zero drift, "
                  "calibration, quantisation, phase sampling, clock; GUM, docs/run-results.md); "
                  "their 95 % expanded uncertainty is k·u with k about 2 (swtlab results lists "
-                 "k, u95 and every term). A run id opens its time series.")
+                 "k, u95 and every term). Each u has two significant digits and its mean the "
+                 "same decimal (GUM 7.2.6). A run's flags and reasons are under its row. A run "
+                 "id opens its time series.")
     numeric = frozenset({2, 3, 4, 5, *range(8, 8 + 2 * len(TABLE_QUANTITIES))})
     return Section(RUNS, "Runs", [Note(summary), Table(
-        header, rows, numeric=numeric, row_classes=classes, html_columns=frozenset({0, 6}))])
+        header, rows, numeric=numeric, row_classes=classes, html_columns=frozenset({0, 6}),
+        row_notes=notes)])
 
 
 def timeseries_image(index: int, run: RunRecord, palette: Palette) -> Drawing:

@@ -15,9 +15,11 @@ def plain_text(text: str) -> str:
     return str(text).replace("$", r"\$")
 
 
-#: colour-blind-safe (Okabe & Ito 2008), assigned to the campaign's loads in rising order
+#: colour-blind-safe, assigned to the campaign's loads in rising order: Okabe & Ito (2008),
+#: then Paul Tol's "muted" scheme (2021) for campaigns of more loads
 LOAD_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#D55E00", "#CC79A7", "#56B4E9", "#F0E442",
-                "#000000")
+                "#000000", "#332288", "#88CCEE", "#44AA99", "#117733", "#999933", "#DDCC77",
+                "#CC6677", "#882255", "#AA4499")
 #: multipass 0, 1, 2, ... (cycled beyond)
 MULTIPASS_LINES = ("-", "--", ":", "-.")
 MULTIPASS_MARKERS = ("o", "s", "^", "D")
@@ -97,15 +99,30 @@ def value_text(quantity: Quantity, si_value: float, digits: int = 3) -> str:
     return f"{number}{'' if quantity.unit in ('°', '%') else ' '}{quantity.unit}"
 
 
+def load_colours(count: int) -> tuple[str, ...]:
+    """``count`` distinct colours: :data:`LOAD_COLOURS`, then (a campaign of more loads) the
+    others evenly spaced along the ``turbo`` colour map; no two loads share one."""
+    extra = count - len(LOAD_COLOURS)
+    if extra <= 0:
+        return LOAD_COLOURS[:count]
+    from matplotlib import colormaps
+    from matplotlib.colors import to_hex
+
+    more = [to_hex(c) for c in colormaps["turbo"]([(i + 0.5) / extra for i in range(extra)])]
+    return LOAD_COLOURS + tuple(more)
+
+
 class Palette:
-    """Colour per load and line style/marker per multipass, fixed for one campaign."""
+    """Colour per load (each its own, :func:`load_colours`) and line style/marker per
+    multipass, fixed for one campaign."""
 
     def __init__(self, loads_n, multipasses) -> None:
         self.loads = sorted({float(x) for x in loads_n})
         self.multipasses = sorted({int(m) for m in multipasses})
+        self.colours = load_colours(len(self.loads))
 
     def colour(self, load_n: float) -> str:
-        return LOAD_COLOURS[self.loads.index(float(load_n)) % len(LOAD_COLOURS)]
+        return self.colours[self.loads.index(float(load_n))]
 
     def line(self, multipass: int) -> str:
         return MULTIPASS_LINES[self.multipasses.index(int(multipass)) % len(MULTIPASS_LINES)]

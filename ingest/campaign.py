@@ -9,6 +9,7 @@ from ingest.channel_map import ChannelMap, load_channel_map
 from ingest.errors import IngestError
 from ingest.formats import BY_SUFFIX, ROS2_METADATA
 from ingest.run import Run, read_run
+from ingest.structured import SIDECAR_SUFFIX
 
 
 #: run files found by extension (each is then read by its content, ingest.formats.sniff)
@@ -27,7 +28,8 @@ class CampaignRead:
 def find_runs(root: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> list[Path]:
     """Run files/folders under ``root`` (sorted): files with a RUN_SUFFIXES extension, folders
     holding ``run.json`` (CSV form) or ``metadata.yaml`` (ROS 2 bag);
-    files matching the map's ``files.pattern`` for a delimited map."""
+    files matching the map's ``files.pattern`` for a delimited map (sidecars
+    ``<run>.run.json`` aside)."""
     root = Path(root)
     cmap = load_channel_map(channel_map)
     if not root.exists():
@@ -35,7 +37,8 @@ def find_runs(root: str | Path, channel_map: "str | Path | ChannelMap | None" = 
     if cmap.format == "delimited":
         if root.is_file():
             return [root]
-        return sorted(p for p in root.rglob(cmap.file_pattern or "*") if p.is_file())
+        return sorted(p for p in root.rglob(cmap.file_pattern or "*")
+                      if p.is_file() and not p.name.endswith(SIDECAR_SUFFIX))
     if root.is_file():
         return [root] if root.suffix.lower() in RUN_SUFFIXES else []
     bags = {p.parent for p in root.rglob(ROS2_METADATA)}

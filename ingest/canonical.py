@@ -27,3 +27,10 @@ DERIVED: tuple[str, ...] = ("wheel_omega_radps", "wheel_surface_speed_mps", "sle
                             "slip", "hub_height_m", "sinkage_m")
 
 CANONICAL: tuple[str, ...] = tuple(MEASURED) + DIRECT
+
+#: what the stable phase gates on (``stable_phase.gate``: the wheel's and the sled's speeds),
+#: each with the channels a source may give it from
+STABLE_PHASE_NEEDS: dict[str, tuple[str, ...]] = {
+    "wheel_surface_speed_mps": ("wheel_angle_rad", "wheel_omega_radps", "wheel_surface_speed_mps"),
+    "sled_velocity_mps": ("sled_position_m", "sled_velocity_mps"),
+}

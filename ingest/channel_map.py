@@ -6,6 +6,7 @@ the CMU motion logs and the rig's bags.
 
 from __future__ import annotations
 
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field, replace
@@ -15,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ingest import units
-from ingest.canonical import CANONICAL
+from ingest.canonical import CANONICAL, DERIVED
 from ingest.errors import IngestError
 
 FORMATS = ("spec", "delimited")
@@ -219,6 +220,11 @@ def _channel(path: Path, raw: Any, fmt: str, stream: str) -> ChannelSpec:
     _check_keys(path, where, raw, _CHANNEL_KEYS)
     if not isinstance(column, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", column):
         raise _fail(path, where, "every [[channels]] entry needs column = '<snake_case_name>'")
+    near = None if column in CANONICAL else near_canonical(column)
+    if near is not None:
+        raise _fail(path, where, f"`{column}` is not a canonical column; did you mean "
+                    f"`{near}`? (the source's unit goes in `unit`; an extra column needs a "
+                    f"name more than {NEAR_EDITS} edits from every canonical one)")
     quantity = units.column_quantity(column)
     if column not in CANONICAL and quantity == "dimensionless":
         raise _fail(path, where, "not a canonical column; an extra column must end in its SI "
@@ -246,6 +252,34 @@ def _channel(path: Path, raw: Any, fmt: str, stream: str) -> ChannelSpec:
                        zero=zero,
                        zero_value=_number(path, f"{where}.zero_value", raw.get("zero_value"), 0.0),
                        stamp=_text(path, f"{where}.stamp", raw.get("stamp")))
+
+
+#: an extra column this close to a canonical name (Levenshtein edits) is taken for a typo
+NEAR_EDITS = 2
+
+
+def edits(a: str, b: str) -> int:
+    """Levenshtein distance: insertions, deletions and substitutions turning ``a`` into ``b``."""
+    row = list(range(len(b) + 1))
+    for i, x in enumerate(a, 1):
+        row, previous = [i], row
+        for j, y in enumerate(b, 1):
+            row.append(min(previous[j] + 1, row[j - 1] + 1, previous[j - 1] + (x != y)))
+    return row[-1]
+
+
+def near_canonical(column: str) -> str | None:
+    """The canonical or derived column ``column`` looks like a misspelling of: one within
+    :data:`NEAR_EDITS` edits (``sled_postion_m``, ``fz_nn``), or one with another unit
+    after its name (``sled_position_mm``, ``dp_kn``); None for a name like none of them."""
+    names = [c for c in dict.fromkeys(CANONICAL + DERIVED) if c != column]
+    prefix = {c: len(os.path.commonprefix([column, c])) for c in names}  # ties: the likelier
+    distance, _, best = min((edits(column, c), -prefix[c], c) for c in names)
+    if distance <= NEAR_EDITS:
+        return best
+    stem, _, unit = column.rpartition("_")
+    return next((c for c in names if stem and "_" not in unit and units.column_quantity(c)
+                 != "dimensionless" and c.rpartition("_")[0] == stem), None)
 
 
 def _filename_fields(path: Path, table: dict) -> tuple[str | None, tuple[FilenameField, ...]]:

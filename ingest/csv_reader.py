@@ -10,6 +10,7 @@ import pandas as pd
 
 from ingest.channel_map import ChannelMap
 from ingest.checks import numeric_column
+from ingest.cut_short import CUT_LINE, last_line_cut
 from ingest.errors import IngestError
 from ingest.raw import FrameIndex, RawRun, RawTopic
 
@@ -35,7 +36,7 @@ def read_csv_run(folder: Path, cmap: ChannelMap) -> RawRun:
     """Raw topics of a CSV run folder, the records of its ``run.json``, and its frames."""
     folder = Path(folder)
     records = read_run_json(folder / "run.json")
-    topics = {}
+    topics, cut = {}, []
     for topic in cmap.topics:
         specs = cmap.channels_of(topic)
         csv_path = folder / specs[0].csv_name
@@ -43,8 +44,10 @@ def read_csv_run(folder: Path, cmap: ChannelMap) -> RawRun:
             raise IngestError(folder, topic, f"channel map {cmap.name}: {specs[0].csv_name} "
                               "lies outside the run's folder; a map may only name files in it")
         if csv_path.is_file():
-            topics[topic] = _read_topic(csv_path, cmap, {c.csv_column or c.field: c.field
-                                                         for c in specs})
+            topics[topic], cut_here = _read_topic(csv_path, cmap, {c.csv_column or c.field:
+                                                                   c.field for c in specs})
+            if cut_here:
+                cut.append(csv_path.name)
     frames = {}
     side = _side_frames(folder)
     if side is not None:
@@ -54,16 +57,21 @@ def read_csv_run(folder: Path, cmap: ChannelMap) -> RawRun:
         files = tuple(sorted(p for p in track.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES))
         frames["/camera/track"] = FrameIndex("/camera/track", np.full(len(files), np.nan),
                                              folder, files=files)
-    return RawRun(path=folder, records=records, topics=topics, frames=frames)
+    return RawRun(path=folder, records=records, topics=topics, frames=frames,
+                  cut_short=f"{', '.join(cut)}: {CUT_LINE}" if cut else None)
 
 
-def _read_topic(path: Path, cmap: ChannelMap, fields: dict[str, str]) -> RawTopic:
+def _read_topic(path: Path, cmap: ChannelMap, fields: dict[str, str]) -> tuple[RawTopic, bool]:
     """One topic CSV: a header row, the time column first, then the fields (CSV column ->
-    source field name); other columns are ignored, absent ones are left to the coverage check."""
+    source field name); other columns are ignored, absent ones are left to the coverage check.
+    True beside it when its last line was cut (and dropped)."""
     try:
         frame = pd.read_csv(path, engine="c")
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise IngestError(path, None, f"cannot parse CSV: {exc}") from None
+    cut = last_line_cut(path)
+    if cut:
+        frame = frame.iloc[:-1]  # a row the logger did not finish (ingest.cut_short)
     if len(frame.columns) == 0 or frame.columns[0] != cmap.time_column:
         raise IngestError(path, cmap.time_column, f"first column must be {cmap.time_column!r} "
                           f"(found {frame.columns[0] if len(frame.columns) else 'none'!r})")
@@ -74,7 +82,7 @@ def _read_topic(path: Path, cmap: ChannelMap, fields: dict[str, str]) -> RawTopi
             continue
         out[name] = numeric_column(path, frame, column, first_row=2)  # after the header
     t = out.pop("t") * cmap.time_scale_s
-    return RawTopic(t_s=t, fields=out)
+    return RawTopic(t_s=t, fields=out), cut
 
 
 def _side_frames(folder: Path) -> FrameIndex | None:

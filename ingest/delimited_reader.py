@@ -8,6 +8,7 @@ import pandas as pd
 
 from ingest.channel_map import ChannelMap
 from ingest.checks import numeric_column
+from ingest.cut_short import CUT_LINE, last_line_cut
 from ingest.errors import IngestError
 from ingest.raw import RawRun, RawTopic
 
@@ -23,6 +24,9 @@ def read_delimited(path: Path, cmap: ChannelMap) -> RawRun:
         raise IngestError(path, None, "empty file") from None
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise IngestError(path, None, f"cannot parse as delimited text: {exc}") from None
+    cut = last_line_cut(path)
+    if cut:
+        frame = frame.iloc[:-1]  # a row the logger did not finish (ingest.cut_short)
     if frame.shape[1] != len(cmap.columns):
         raise IngestError(path, None, f"{frame.shape[1]} columns, the channel map "
                           f"{cmap.path.name} expects {len(cmap.columns)} "
@@ -36,4 +40,5 @@ def read_delimited(path: Path, cmap: ChannelMap) -> RawRun:
         fields[name] = numeric_column(path, frame, name, first_row=1 + cmap.header_rows)
     t = fields.pop(cmap.time_column)
     t_s = (t - t[0]) * cmap.time_scale_s if len(t) else t
-    return RawRun(path=path, records={}, topics={cmap.stream: RawTopic(t_s=t_s, fields=fields)})
+    return RawRun(path=path, records={}, topics={cmap.stream: RawTopic(t_s=t_s, fields=fields)},
+                  cut_short=CUT_LINE if cut else None)

@@ -60,8 +60,8 @@ def sniff(path: Path) -> str:
     raise IngestError(path, None, f"not a run: unknown format (first bytes {head[:8]!r}); "
                       "swtlab reads MCAP, HDF5, MATLAB .mat, NI TDMS, ROS 1/2 bags, CSV run "
                       "folders "
-                      "(for a text log pass its channel map, e.g. --channel-map "
-                      "cmu_3d_terramechanics)")
+                      "(for a text log pass its channel map, e.g. "
+                      "channel_map='cmu_3d_terramechanics')")
 
 
 def is_ros_bag(path: Path) -> bool:
@@ -87,8 +87,14 @@ def _mcap_is_cdr(path: Path) -> bool:
 
 
 def read_raw_file(path: Path, cmap: ChannelMap) -> RawRun:
-    """Read ``path`` with the reader of its sniffed format."""
+    """Read ``path`` with the reader of its sniffed format (named in the raw run's ``form``)."""
     fmt = sniff(path)
+    raw = _read(path, cmap, fmt)
+    raw.form = fmt
+    return raw
+
+
+def _read(path: Path, cmap: ChannelMap, fmt: str) -> RawRun:
     if fmt == "mcap":
         from ingest.mcap_reader import read_mcap
         return read_mcap(path, set(cmap.topics))

@@ -1,8 +1,8 @@
 """HDF5 reader (h5py): one group per topic (its path is the map's topic), one dataset per field.
 
 Time: the map's ``[time] column`` dataset in each group, else ``t_ns`` (whole ns). Metadata:
-attributes ``"<record>.<key>"`` of the root group, attributes of ``/swt/<record>`` groups, then
-the sidecar ``<name>.run.json``.
+attributes ``"<record>.<key>"`` or ``"swt.<record>.<key>"`` of the root group, attributes of
+``/swt/<record>`` groups, then the sidecar ``<name>.run.json`` (``ingest.records``).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import h5py
 from ingest.channel_map import ChannelMap
 from ingest.errors import IngestError
 from ingest.raw import RawRun
-from ingest.structured import dotted_records, raw_topic, scalar, sidecar_records, time_s
+from ingest.structured import dotted_records, raw_topic, scalar, time_s
 
 _HINT = "the file is damaged, cut short or not HDF5; re-export it"
 
@@ -38,8 +38,6 @@ def read_hdf5(path: Path, cmap: ChannelMap) -> RawRun:
         raise
     except OSError as exc:
         raise IngestError(path, None, f"cannot read HDF5 ({exc}); {_HINT}") from None
-    for name, values in sidecar_records(path).items():
-        records.setdefault(name, {}).update(values)
     return RawRun(path=path, records=records, topics=topics)
 
 

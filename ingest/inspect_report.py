@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ingest.canonical import STABLE_PHASE_NEEDS
 from ingest.run import Run
 from plain_json import jsonable
 
@@ -27,6 +28,15 @@ def stream_report(run: Run) -> list[dict]:
                      for topic, frame in run.streams.items()])
 
 
+def stable_phase_missing(run: Run) -> list[str]:
+    """``"<column>: ..."`` for each channel the stable phase needs that the run lacks
+    (no finite sample)."""
+    return [f"{column}: the stable phase needs it (from {' or '.join(sources)}); not in this "
+            f"source (channel map {run.channel_map})"
+            for column, sources in STABLE_PHASE_NEEDS.items()
+            if not np.isfinite(run.channels[column].to_numpy()).any()]
+
+
 def report(run: Run) -> dict:
     """Metadata, each stream's channels with rate/span/gaps/units, the time base and problems."""
     table = run.channels
@@ -42,7 +52,8 @@ def report(run: Run) -> dict:
                    "time_base": run.derivation.get("time_base"), "channels": columns,
                    "frames": [f.to_dict() for f in run.frames.values()],
                    "derivation": run.derivation,
-                   "problems": [p.to_dict() for p in run.problems]})
+                   "problems": [p.to_dict() for p in run.problems],
+                   "stable_phase_missing": stable_phase_missing(run)})
 
 
 def _fmt(value) -> str:

@@ -3,7 +3,8 @@
 One struct variable per topic, named as the topic with slashes to underscores
 (``/hub/wrench`` -> ``hub_wrench``), one numeric field per source field; time as in the
 map's ``[time] column`` or ``t_ns``. Metadata: a struct ``swt`` of record structs
-(``swt.run.run_id = 'r001'``), then the sidecar ``<name>.run.json``.
+(``swt.run.run_id = 'r001'``) or record structs of their own (``run.run_id = 'r001'``), then
+the sidecar ``<name>.run.json`` (``ingest.records``).
 """
 
 from __future__ import annotations
@@ -14,8 +15,9 @@ import numpy as np
 
 from ingest.channel_map import ChannelMap
 from ingest.errors import IngestError
+from ingest.metadata import RECORDS
 from ingest.raw import RawRun
-from ingest.structured import raw_topic, scalar, sidecar_records, time_s, variable_name
+from ingest.structured import raw_topic, scalar, time_s, variable_name
 
 _HINT = "the file is damaged or cut short; save it again from MATLAB"
 
@@ -27,11 +29,15 @@ def read_mat(path: Path, cmap: ChannelMap, version: str) -> RawRun:
     swt = variables.get("swt", {})
     if not isinstance(swt, dict):
         raise IngestError(path, "swt", "must be a struct of record structs (swt.run.run_id)")
-    records = {}
-    for name, record in swt.items():
+    records: dict[str, dict] = {}
+    structs = [(f"swt.{n}", n, r) for n, r in swt.items()]
+    # record structs of their own (run.run_id); a variable of another kind is not ours
+    structs += [(n, n, variables[n]) for n in RECORDS if isinstance(variables.get(n), dict)]
+    for where, name, record in structs:
         if not isinstance(record, dict):
-            raise IngestError(path, f"swt.{name}", "must be a struct of metadata values")
-        records[name] = {k: scalar(path, f"swt.{name}.{k}", v) for k, v in record.items()}
+            raise IngestError(path, where, "must be a struct of metadata values")
+        records.setdefault(name, {}).update(
+            {k: scalar(path, f"{where}.{k}", v) for k, v in record.items()})
     topics = {}
     for topic in cmap.topics:
         name = variable_name(topic)
@@ -46,8 +52,6 @@ def read_mat(path: Path, cmap: ChannelMap, version: str) -> RawRun:
             raise IngestError(path, topic, f"struct {name} has no time field "
                               f"({cmap.time_column!r} or 't_ns')")
         topics[topic] = raw_topic(path, topic, cmap, found[0], struct.get)
-    for name, values in sidecar_records(path).items():
-        records.setdefault(name, {}).update(values)
     return RawRun(path=path, records=records, topics=topics)
 
 

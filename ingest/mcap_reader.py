@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import array
 import json
+from io import BytesIO
 from collections import defaultdict
 from itertools import chain
 from pathlib import Path
@@ -17,6 +18,12 @@ from pathlib import Path
 import numpy as np
 import orjson
 from mcap.reader import NonSeekingReader, make_reader
+import lz4.frame
+import zstandard
+from mcap.data_stream import ReadDataStream
+from mcap.opcode import Opcode
+from mcap.records import Channel, Chunk, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk
 
 from ingest.errors import IngestError
 from ingest.json_blocks import FIELD_COLUMNS, parse_blocks
@@ -28,10 +35,11 @@ _HINT = "the file is damaged or was cut short; re-export it (or try `mcap recove
 
 
 def read_mcap(path: Path, topics: set[str]) -> RawRun:
-    """Raw topics (only those in ``topics``), ``swt.*`` records and image topics of one MCAP run."""
+    """Raw topics (only those in ``topics``), ``swt.*`` records and image topics of one MCAP run;
+    an MCAP cut short (no summary, no footer) gives what its whole records hold
+    (:func:`_recover`)."""
     path = Path(path)
-    blocks: dict[str, list[bytes]] = defaultdict(list)
-    images: dict[str, list[bytes]] = defaultdict(list)
+    cut = None
     try:
         with open(path, "rb") as stream:
             reader = make_reader(stream, validate_crcs=True)
@@ -41,25 +49,104 @@ def read_mcap(path: Path, topics: set[str]) -> RawRun:
                 scan = NonSeekingReader(stream, validate_crcs=True)
                 records = _swt_records(scan.iter_metadata())
                 stream.seek(0)
-            for schema, channel, message in reader.iter_messages(log_time_order=False):
-                if channel.topic in IMAGE_TOPICS or (schema is not None
-                                                     and schema.name == IMAGE_SCHEMA):
-                    images[channel.topic].append(message.data)
-                elif channel.topic in topics:
-                    if channel.message_encoding != "json":
-                        raise IngestError(path, channel.topic, f"message encoding "
-                                          f"{channel.message_encoding!r}; the spec form uses json")
-                    blocks[channel.topic].append(message.data)
+            blocks, images = _collect(path, topics, reader.iter_messages(log_time_order=False))
     except IngestError:
         raise
     except OSError as exc:
         raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
     except Exception as exc:  # noqa: BLE001 - mcap raises many types for damaged files
-        raise IngestError(path, None, f"corrupt or truncated MCAP "
-                          f"({type(exc).__name__}: {exc}); {_HINT}") from None
+        records, blocks, images = _recover(path, topics, exc)
+        cut = CUT_MCAP
     raw_topics = {topic: _decode_blocks(path, topic, data) for topic, data in blocks.items()}
     frames = {topic: _frame_index(path, topic, data) for topic, data in images.items()}
-    return RawRun(path=path, records=records, topics=raw_topics, frames=frames)
+    return RawRun(path=path, records=records, topics=raw_topics, frames=frames, cut_short=cut)
+
+
+#: why an MCAP that ends before its summary looks cut short (``ingest.cut_short``)
+CUT_MCAP = ("truncated MCAP: no summary and no footer (the logger stopped mid-write); the "
+            "messages of its whole records are read")
+
+
+def _collect(path: Path, topics: set[str], messages) -> tuple[dict, dict]:
+    """Message data by topic (``topics`` only) and image messages by topic, from
+    ``(schema, channel, message)`` triples."""
+    blocks: dict[str, list[bytes]] = defaultdict(list)
+    images: dict[str, list[bytes]] = defaultdict(list)
+    for schema, channel, message in messages:
+        if channel.topic in IMAGE_TOPICS or (schema is not None
+                                             and schema.name == IMAGE_SCHEMA):
+            images[channel.topic].append(message.data)
+        elif channel.topic in topics:
+            if channel.message_encoding != "json":
+                raise IngestError(path, channel.topic, f"message encoding "
+                                  f"{channel.message_encoding!r}; the spec form uses json")
+            blocks[channel.topic].append(message.data)
+    return blocks, images
+
+
+def _recover(path: Path, topics: set[str], error: Exception) -> tuple[dict, dict, dict]:
+    """Records, message data and images of an MCAP that ends before its summary and footer
+    (a logger stopped mid-write): the file's records in order up to its end, and the whole
+    records at the start of a chunk cut by the end (:func:`_cut_chunk`). A file whose
+    reading fails before its end is damaged, not cut short: an IngestError naming ``error``."""
+    size = path.stat().st_size
+    found: list = []
+    with open(path, "rb") as stream:
+        done = stream.tell()
+        try:
+            for record in StreamReader(stream, emit_chunks=True, validate_crcs=True).records:
+                found += breakup_chunk(record, True) if isinstance(record, Chunk) else [record]
+                done = stream.tell()
+            at_end = False  # a footer: the file is whole, the first reading failed elsewhere
+        except Exception:  # noqa: BLE001 - where it stopped decides
+            at_end = stream.tell() >= size
+            stream.seek(done)
+            found += _cut_chunk(stream.read()) if at_end else []
+    schemas = {r.id: r for r in found if isinstance(r, Schema)}
+    channels = {r.id: r for r in found if isinstance(r, Channel)}
+    if not at_end or not channels:
+        raise IngestError(path, None, f"corrupt or truncated MCAP ({type(error).__name__}: "
+                          f"{error}); {_HINT}")
+    triples = [(schemas.get(channels[r.channel_id].schema_id), channels[r.channel_id], r)
+               for r in found if isinstance(r, Message) and r.channel_id in channels]
+    return (_swt_records(r for r in found if isinstance(r, Metadata)),
+            *_collect(path, topics, triples))
+
+
+def _cut_chunk(tail: bytes) -> list:
+    """The whole schema, channel and message records at the start of a chunk record cut by
+    the end of the file (``tail``: the bytes from the record's opcode); [] for other records.
+    Layout: MCAP specification, "Chunk" (opcode 0x06)."""
+    if tail[:1] != bytes([Opcode.CHUNK]):
+        return []
+    head = ReadDataStream(BytesIO(tail[9:]))
+    try:
+        head.read(28)  # message start and end time, uncompressed size and CRC
+        compression = head.read(head.read4()).decode()
+        head.read8()
+        data = tail[9 + head.count:]
+        if compression == "zstd":
+            data = zstandard.ZstdDecompressor().decompressobj().decompress(data)
+        elif compression == "lz4":
+            data = lz4.frame.LZ4FrameDecompressor().decompress(data)
+        elif compression:
+            return []
+    except Exception:  # noqa: BLE001 - too little of the chunk to read
+        return []
+    out, at = [], 0
+    readers = {Opcode.SCHEMA: Schema.read, Opcode.CHANNEL: Channel.read}
+    while at + 9 <= len(data):
+        opcode, length = data[at], int.from_bytes(data[at + 1:at + 9], "little")
+        body = data[at + 9:at + 9 + length]
+        if len(body) < length:
+            break
+        stream = ReadDataStream(BytesIO(body))
+        if opcode == Opcode.MESSAGE:
+            out.append(Message.read(stream, length))
+        elif opcode in readers:
+            out.append(readers[opcode](stream))
+        at += 9 + length
+    return out
 
 
 def _swt_records(metadata) -> dict[str, dict[str, str]]:

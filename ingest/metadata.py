@@ -20,6 +20,8 @@ from swtlab.domain.ranges import METADATA
 MAX_SHOWN_CHARS = 40
 WRENCH_FIELDS = ("fx", "fy", "fz", "tx", "ty", "tz")
 RECORDS = ("run", "wheel", "suspension", "camera", "camera_track", "zero", "calibration")
+#: where the spec's MCAP form keeps a record (errors name the form of the user's file)
+SPEC_FORM = "the swt.{record} metadata record"
 
 _RUN_KEYS = {"run_id", "campaign", "wheel", "soil", "multipass", "mode", "load_N",
              "slip_setpoint", "velocity_mps", "gravity_mps2", "steer_deg", "started_at",
@@ -117,8 +119,8 @@ def _shown(value: Any) -> str:
 class _Reader:
     """Typed access to one record; every failure is an IngestError naming record.key."""
 
-    def __init__(self, path: Path, name: str, values: Mapping[str, Any]):
-        self.path, self.name, self.values = path, name, values
+    def __init__(self, path: Path, name: str, values: Mapping[str, Any], form: str = SPEC_FORM):
+        self.path, self.name, self.values, self.form = path, name, values, form
 
     def fail(self, key: str, problem: str) -> IngestError:
         return IngestError(self.path, f"swt.{self.name}.{key}", problem)
@@ -127,7 +129,8 @@ class _Reader:
         value = self.values.get(key)
         if value is None or (isinstance(value, str) and not value.strip()):
             if required:
-                raise self.fail(key, f"missing; add it to the swt.{self.name} metadata record")
+                raise self.fail(key, f"missing; add {self.name}.{key} to "
+                                     f"{self.form.format(record=self.name)}")
             return None
         if isinstance(value, (bool, list, dict)):
             raise self.fail(key, f"{_shown(value)} is not {kind}")
@@ -163,8 +166,8 @@ def _unknown_keys(name: str, values: Mapping[str, Any], known: set[str]) -> list
             for k in sorted(set(values) - known)]
 
 
-def _run_info(path: Path, values: Mapping[str, Any]) -> RunInfo:
-    r = _Reader(path, "run", values)
+def _run_info(path: Path, values: Mapping[str, Any], form: str) -> RunInfo:
+    r = _Reader(path, "run", values, form)
     mode = r.text("mode")
     if mode not in MODES:
         raise r.fail("mode", f"unknown mode {mode!r}; use one of {', '.join(MODES)}")
@@ -211,8 +214,8 @@ def _slip_from_speeds(surface_speed_mps: float, velocity_mps: float) -> float | 
     return None if denominator <= 0 else (surface_speed_mps - velocity_mps) / denominator
 
 
-def _wheel_info(path: Path, values: Mapping[str, Any], name: str) -> Wheel:
-    r = _Reader(path, "wheel", values)
+def _wheel_info(path: Path, values: Mapping[str, Any], name: str, form: str) -> Wheel:
+    r = _Reader(path, "wheel", values, form)
     grousers = r.integer("grouser_count")
     if grousers < 0:
         raise r.fail("grouser_count", f"{grousers} must be >= 0")
@@ -225,8 +228,8 @@ def _wheel_info(path: Path, values: Mapping[str, Any], name: str) -> Wheel:
                  mass_kg=r.positive("mass_kg", required=False), name=name)
 
 
-def _camera_info(path: Path, values: Mapping[str, Any]) -> CameraInfo:
-    r = _Reader(path, "camera", values)
+def _camera_info(path: Path, values: Mapping[str, Any], form: str) -> CameraInfo:
+    r = _Reader(path, "camera", values, form)
     direction = r.text("travel_direction", required=False) or "+x"
     if direction not in ("+x", "-x"):
         raise r.fail("travel_direction", f"{direction!r}: use +x or -x")
@@ -242,8 +245,8 @@ def _camera_info(path: Path, values: Mapping[str, Any]) -> CameraInfo:
                       wheel_radius_px=r.positive("wheel_radius_px", required=False))
 
 
-def _zero(path: Path, values: Mapping[str, Any]) -> dict[str, float]:
-    r = _Reader(path, "zero", values)
+def _zero(path: Path, values: Mapping[str, Any], form: str) -> dict[str, float]:
+    r = _Reader(path, "zero", values, form)
     unknown = set(values) - set(WRENCH_FIELDS)
     if unknown:
         key = sorted(unknown)[0]
@@ -254,11 +257,11 @@ def _zero(path: Path, values: Mapping[str, Any]) -> dict[str, float]:
 CALIBRATION_PARTS = ("gain", "offset", "gain_rel_u", "offset_u")  # raw-run spec, swt.calibration
 
 
-def _calibration(path: Path, values: Mapping[str, Any]
+def _calibration(path: Path, values: Mapping[str, Any], form: str
                  ) -> tuple[dict[tuple[str, str], tuple[float, float]],
                             dict[tuple[str, str], tuple[float, float]]]:
     """``(gain, offset)`` and, where stated, ``(gain_rel_u, offset_u)`` per (topic, field)."""
-    r = _Reader(path, "calibration", values)
+    r = _Reader(path, "calibration", values, form)
     parts: dict[tuple[str, str], dict[str, float]] = {}
     for key in values:
         topic, _, rest = key.rpartition(".")
@@ -282,14 +285,17 @@ def _calibration(path: Path, values: Mapping[str, Any]
 
 
 def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
-                   needs_suspension: bool = True) -> tuple[RunMetadata, list[Problem]]:
-    """Typed metadata from raw records; raises IngestError on missing or contradictory values."""
+                   needs_suspension: bool = True,
+                   form: str = SPEC_FORM) -> tuple[RunMetadata, list[Problem]]:
+    """Typed metadata from raw records; raises IngestError on missing or contradictory values.
+    ``form``: where the run's file keeps a record (``{record}`` filled in), for the errors."""
     path = Path(path)
     records = {name: values for name, values in records.items() if values}  # {} = absent
     problems: list[Problem] = []
     for name in ("run", "wheel"):
         if name not in records:
-            raise IngestError(path, f"swt.{name}", "metadata record missing")
+            raise IngestError(path, f"swt.{name}", f"metadata record missing; give its keys "
+                              f"({name}.<key>) in {form.format(record=name)}")
     for name, known in (("run", _RUN_KEYS), ("wheel", _WHEEL_KEYS),
                         ("suspension", _SUSPENSION_KEYS), ("camera", _CAMERA_KEYS),
                         ("camera_track", {"px_per_m"})):
@@ -298,25 +304,25 @@ def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
                  for n in sorted(set(records) - set(RECORDS))]
     suspension = None
     if "suspension" in records:
-        r = _Reader(path, "suspension", records["suspension"])
+        r = _Reader(path, "suspension", records["suspension"], form)
         suspension = SuspensionInfo(arm_length_m=r.positive("arm_length_m"),
                                     angle_zero_rad=r.number("angle_zero_rad"))
     elif needs_suspension:
         raise IngestError(path, "swt.suspension",
                           "metadata record missing; hub height needs arm_length_m and "
-                          "angle_zero_rad")
+                          f"angle_zero_rad: add them to {form.format(record='suspension')}")
     camera_track = None
     if "camera_track" in records:
-        camera_track = CameraTrackInfo(
-            px_per_m=_Reader(path, "camera_track", records["camera_track"]).positive("px_per_m"))
-    run = _run_info(path, records["run"])
-    calibration, calibration_u = _calibration(path, records.get("calibration", {}))
+        track = _Reader(path, "camera_track", records["camera_track"], form)
+        camera_track = CameraTrackInfo(px_per_m=track.positive("px_per_m"))
+    run = _run_info(path, records["run"], form)
+    calibration, calibration_u = _calibration(path, records.get("calibration", {}), form)
     metadata = RunMetadata(
-        run=run, wheel=_wheel_info(path, records["wheel"], run.wheel),
+        run=run, wheel=_wheel_info(path, records["wheel"], run.wheel, form),
         suspension=suspension,
-        camera=_camera_info(path, records["camera"]) if "camera" in records else None,
+        camera=_camera_info(path, records["camera"], form) if "camera" in records else None,
         camera_track=camera_track,
-        zero=_zero(path, records.get("zero", {})),
+        zero=_zero(path, records.get("zero", {}), form),
         calibration=calibration, calibration_u=calibration_u)
     _check_ranges(path, metadata)
     return metadata, problems

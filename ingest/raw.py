@@ -62,9 +62,14 @@ class FrameIndex:
 
 @dataclass
 class RawRun:
-    """A run as read from its files, before mapping, calibration and checks."""
+    """A run as read from its files, before mapping, calibration and checks; ``cut_short``:
+    why the file looks cut short (``ingest.cut_short``), None for a whole file; ``form``: the
+    file's format (``ingest.formats.FORMATS``, or ``delimited``), which says where its
+    metadata records live (``ingest.records.FORMS``)."""
 
     path: Path
     records: dict[str, dict]
     topics: dict[str, RawTopic]
     frames: dict[str, FrameIndex] = field(default_factory=dict)
+    cut_short: str | None = None
+    form: str = "mcap"

@@ -9,15 +9,41 @@ from typing import Any
 from ingest import units
 from ingest.channel_map import ChannelMap
 from ingest.errors import IngestError
+from ingest.structured import sidecar_path, sidecar_records
 
 #: unit of a metadata value, by the key's suffix (spec key names)
 _KEY_UNITS = {"_mps": "m/s", "_deg": "deg", "_rad": "rad", "_m": "m", "_N": "N", "_s": "s"}
 
 
+#: where the files of each format (``RawRun.form``) keep a metadata record, ``{record}`` to
+#: fill in (None: the sidecar only); every form also takes the sidecar ``<run>.run.json``
+FORMS: dict[str, str | None] = {
+    "mcap": "the MCAP's swt.{record} metadata record",
+    "csv_run": 'run.json ("{record}": {{...}})',
+    "hdf5": "root attributes {record}.<key> or swt.{record}.<key> (or attributes of the group "
+            "/swt/{record})",
+    "mat5": "a struct {record} or swt.{record} (one field per key)",
+    "mat73": "a struct {record} or swt.{record} (one field per key)",
+    "tdms": "file properties {record}.<key> or swt.{record}.<key>",
+    "delimited": "the channel map's [metadata.{record}] (or its file-name regex)",
+}
+
+
+def metadata_form(path: Path, form: str) -> str:
+    """Where a run's file of format ``form`` keeps a metadata record (``{record}`` to fill
+    in): its format's place, and the sidecar (``ingest.structured.sidecar_path``)."""
+    side = sidecar_path(path).name.replace("{", "{{").replace("}", "}}")
+    own = FORMS.get(form)
+    return f"{own}, or the sidecar {side}" if own else f"the sidecar {side}"
+
+
 def merged_records(path: Path, file_records: dict[str, dict], cmap: ChannelMap) -> dict[str, dict]:
-    """Map defaults < file records < values parsed from the file name."""
+    """Map defaults < file records < the sidecar ``<run>.run.json`` (any format) < values
+    parsed from the file name."""
     out: dict[str, dict[str, Any]] = {k: dict(v) for k, v in cmap.metadata_defaults.items()}
     for name, values in file_records.items():
+        out.setdefault(name, {}).update(values)
+    for name, values in sidecar_records(path).items():
         out.setdefault(name, {}).update(values)
     for key, value in filename_values(path, cmap).items():
         record, _, item = key.partition(".")

@@ -12,7 +12,9 @@ earliest time stamp read. Metadata: the sidecar.
 from __future__ import annotations
 
 import re
+import tempfile
 from collections import defaultdict
+from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -20,7 +22,9 @@ import numpy as np
 
 from ingest.channel_map import ChannelMap
 from ingest.errors import IngestError
+from ingest.formats import sniff
 from ingest.raw import RawRun, RawTopic
+from ingest.ros1_reindex import CUT_BAG, needs_reindex, reindexed
 from ingest.structured import sidecar_records
 
 _STEP = re.compile(r"([A-Za-z_]\w*)(?:\[([^\]]+)\])?")
@@ -28,16 +32,30 @@ _EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
 
 
 def read_ros(path: Path, cmap: ChannelMap) -> RawRun:
-    """The map's topics and message fields of one bag (file or ROS 2 folder)."""
+    """The map's topics and message fields of one bag (file or ROS 2 folder); a ROS 1 bag cut
+    short is read as far as its whole records go (``ingest.ros1_reindex``)."""
     path = Path(path)
     records = sidecar_records(path)
     samples = _Samples(path, cmap)
-    for topic, log_ns, message in _messages(path, set(cmap.topics)):
-        samples.add(topic, log_ns, message)
+    with _readable(path) as (bag, cut):
+        for topic, log_ns, message in _messages(path, bag, set(cmap.topics)):
+            samples.add(topic, log_ns, message)
     if not samples.stamps:
-        return RawRun(path=path, records=records, topics={})
-    return RawRun(path=path, records=records,
-                  topics=samples.raw_topics(_start_ns(path, records, samples.stamps)))
+        return RawRun(path=path, records={}, topics={}, cut_short=cut)
+    return RawRun(path=path, records={},  # the sidecar's records: read_run merges them
+                  topics=samples.raw_topics(_start_ns(path, records, samples.stamps)),
+                  cut_short=cut)
+
+
+@contextmanager
+def _readable(path: Path):
+    """``(bag, cut_short)``: the bag itself and None, or for a ROS 1 bag without its index an
+    indexed copy of its whole records (removed afterwards) and why it looks cut short."""
+    if not (path.is_file() and sniff(path) == "rosbag1" and needs_reindex(path)):
+        yield path, None
+        return
+    with tempfile.TemporaryDirectory(prefix="swtlab-reindex-") as folder:
+        yield reindexed(path, Path(folder) / path.name), CUT_BAG
 
 
 def read_ros_rows(path: Path, cmap: ChannelMap) -> RawRun:
@@ -49,17 +67,18 @@ def read_ros_rows(path: Path, cmap: ChannelMap) -> RawRun:
     path = Path(path)
     samples = _Samples(path, cmap)
     rows, first_row_ns = [], None
-    for topic, log_ns, message in _messages(path, set(cmap.topics) | {cmap.stream}):
-        if topic != cmap.stream:
-            samples.add(topic, log_ns, message)
-            continue
-        row = np.asarray(getattr(message, "data", ()), dtype=np.float64).reshape(-1)
-        if len(row) != len(cmap.columns):
-            raise IngestError(path, cmap.stream, f"message {len(rows)} holds {len(row)} values, "
-                              f"the channel map {cmap.path.name} expects {len(cmap.columns)} "
-                              f"({', '.join(cmap.columns)})")
-        first_row_ns = log_ns if first_row_ns is None else first_row_ns
-        rows.append(row)
+    with _readable(path) as (bag, cut):
+        for topic, log_ns, message in _messages(path, bag, set(cmap.topics) | {cmap.stream}):
+            if topic != cmap.stream:
+                samples.add(topic, log_ns, message)
+                continue
+            row = np.asarray(getattr(message, "data", ()), dtype=np.float64).reshape(-1)
+            if len(row) != len(cmap.columns):
+                raise IngestError(path, cmap.stream, f"message {len(rows)} holds {len(row)} "
+                                  f"values, the channel map {cmap.path.name} expects "
+                                  f"{len(cmap.columns)} ({', '.join(cmap.columns)})")
+            first_row_ns = log_ns if first_row_ns is None else first_row_ns
+            rows.append(row)
     topics = {}
     if samples.stamps:
         start_ns = first_row_ns if first_row_ns is not None else \
@@ -71,7 +90,7 @@ def read_ros_rows(path: Path, cmap: ChannelMap) -> RawRun:
         fields = {name: table[:, i] for i, name in enumerate(cmap.columns) if name in wanted}
         t = fields.pop(cmap.time_column)
         topics[cmap.stream] = RawTopic(t_s=(t - t[0]) * cmap.time_scale_s, fields=fields)
-    return RawRun(path=path, records=sidecar_records(path), topics=topics)
+    return RawRun(path=path, records={}, topics=topics, cut_short=cut)  # sidecar: read_run
 
 
 class _Samples:
@@ -107,15 +126,16 @@ class _Samples:
         return topics
 
 
-def _messages(path: Path, topics: set[str]):
-    """(topic, log time ns, decoded message) of the bag's messages on ``topics``, in log time
-    order; a damaged bag or a message type nobody defines is one IngestError."""
+def _messages(path: Path, bag: Path, topics: set[str]):
+    """(topic, log time ns, decoded message) of the messages on ``topics`` of ``bag`` (the
+    run's ``path`` or its reindexed copy), in log time order; a damaged bag or a message type
+    nobody defines is one IngestError."""
     from rosbags.highlevel import AnyReader
 
     from ingest.ros_types import default_typestore
 
     try:
-        with AnyReader([path], default_typestore=default_typestore()) as reader:
+        with AnyReader([bag], default_typestore=default_typestore()) as reader:
             wanted = [c for c in reader.connections if c.topic in topics]
             for connection in wanted:
                 if connection.msgtype not in reader.typestore.fielddefs:

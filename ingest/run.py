@@ -8,17 +8,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ingest import derive
+from ingest import cut_short, derive
 from ingest.calibration import subtract_zero, to_canonical
 from ingest.canonical import CANONICAL, DERIVED, MEASURED, SUBSTITUTES, WRENCH_COLUMNS
-from ingest.channel_map import ChannelMap, load_channel_map
+from ingest.channel_map import ChannelMap, ChannelSpec, load_channel_map
 from ingest.checks import check_calibrated, check_topic
 from ingest.delimited_reader import read_delimited
 from ingest.errors import IngestError, Problem
 from ingest.formats import is_ros_bag, read_raw_file
 from ingest.metadata import RunMetadata, parse_metadata
 from ingest.raw import FrameIndex, RawRun
-from ingest.records import merged_records
+from ingest.records import merged_records, metadata_form
 from ingest.ros_reader import read_ros_rows
 from ingest.timebase import (DROP_FACTOR, GAP_FACTOR, JITTER_LIMIT, StreamTiming, common_grid,
                              grid_mask, grid_size, stream_timing, to_grid)
@@ -49,6 +49,8 @@ class Run:
     timing: dict[str, StreamTiming] = field(default_factory=dict)
     units: dict[str, str] = field(default_factory=dict)
     channel_map: str = "spec"
+    #: ``"<file>: file ends at t = ... s (cut short?): <why>"`` when the file looks cut short
+    cut_short: str | None = None
 
     @property
     def run_id(self) -> str:
@@ -58,32 +60,48 @@ class Run:
 def read_run(path: str | Path, channel_map: "str | Path | ChannelMap | None" = None) -> Run:
     """Read one run: a file or folder of any format ``ingest.formats`` recognises by content
     (MCAP, HDF5, MATLAB, TDMS, ROS bags, CSV run folder), or a text log its channel map
-    describes."""
+    describes. A file cut short is read as far as it goes; the run says so in
+    ``cut_short`` (and a run it leaves unusable, in its IngestError)."""
     path = Path(path)
     cmap = load_channel_map(channel_map)
     if cmap.format == "delimited" and not is_ros_bag(path):
         cmap = cmap.text_log_map()  # a text log has only the stream's channels
     raw = _read_raw(path, cmap)
+    if raw.cut_short is None:
+        return _run(path, cmap, raw, None)
+    end = max((float(t.t_s[-1]) for t in raw.topics.values() if len(t.t_s)), default=None)
+    try:
+        return _run(path, cmap, raw, cut_short.message(path, end, raw.cut_short))
+    except IngestError as exc:
+        raise IngestError(exc.path, exc.channel,
+                          f"{exc.problem}; {cut_short.note(end, raw.cut_short)}") from None
+
+
+def _run(path: Path, cmap: ChannelMap, raw: RawRun, cut: str | None) -> Run:
     for topic, data in raw.topics.items():
         check_topic(path, topic, data)
     problems = _coverage_problems(path, raw, cmap)
+    if cut is not None:
+        problems.append(Problem("error", None, cut))
     provided = {c.column for c in cmap.channels
                 if c.topic in raw.topics and c.field in raw.topics[c.topic].fields}
     records = merged_records(path, raw.records, cmap)
     metadata, meta_problems = parse_metadata(path, records,
-                                             needs_suspension="suspension_angle_rad" in provided)
+                                             needs_suspension="suspension_angle_rad" in provided,
+                                             form=metadata_form(path, raw.form))
     problems += meta_problems
     arrays, units = _streams(raw, cmap, metadata, problems)
     timing = {topic: stream_timing(columns["t_s"]) for topic, columns in arrays.items()}
     _check_clocks(path, timing)
     problems += _timing_problems(timing)
     channels, derivation = _channel_table(arrays, timing, metadata, provided, problems)
+    derivation.update(_dp_from_hub(cmap, provided))
     streams = {topic: pd.DataFrame(columns, copy=False)  # their own arrays: no copy
                for topic, columns in arrays.items()}
     problems += _frame_problems(raw.frames, metadata)
     return Run(source=path, metadata=metadata, streams=streams, channels=channels,
                problems=problems, derivation=derivation, frames=raw.frames, timing=timing,
-               units=units, channel_map=cmap.name)
+               units=units, channel_map=cmap.name, cut_short=cut)
 
 
 def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:
@@ -91,10 +109,14 @@ def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:
         raise IngestError(path, None, "no such file or folder")
     if cmap.format == "delimited":
         if is_ros_bag(path):
-            return read_ros_rows(path, cmap)  # the text log's rows recorded in a bag
+            raw = read_ros_rows(path, cmap)  # the text log's rows recorded in a bag
+            raw.form = "rosbag"
+            return raw
         if not path.is_file():
             raise IngestError(path, None, f"channel map {cmap.name} reads one text file per run")
-        return read_delimited(path, cmap)
+        raw = read_delimited(path, cmap)
+        raw.form = "delimited"
+        return raw
     return read_raw_file(path, cmap)
 
 
@@ -127,6 +149,8 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
     """Per topic: native t_s + calibrated, zeroed canonical SI columns (arrays by name)."""
     streams, units = {}, {}
     used = set()
+    # dp_n read as a wrench column is (same field, same conversion) has that column's zero
+    zero_of = {_conversion(c): _ZERO_OF[c.column] for c in cmap.channels if c.column in _ZERO_OF}
     for topic in cmap.topics:
         data = raw.topics.get(topic)
         if data is None:
@@ -139,8 +163,8 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
             used.add((topic, spec.field))
             with np.errstate(over="ignore", invalid="ignore"):
                 values = to_canonical(data.fields[spec.field], spec, cal)
-                if spec.column in _ZERO_OF:
-                    values = subtract_zero(values, metadata.zero.get(_ZERO_OF[spec.column]))
+                if _conversion(spec) in zero_of:
+                    values = subtract_zero(values, metadata.zero.get(zero_of[_conversion(spec)]))
             check_calibrated(raw.path, f"{topic}.{spec.field}", spec.column, values)
             columns[spec.column] = values
             units[spec.column] = spec.unit if cal is None else "SI (swt.calibration)"
@@ -149,6 +173,28 @@ def _streams(raw: RawRun, cmap: ChannelMap, metadata: RunMetadata,
         problems.append(Problem("warning", f"{topic}.{fld}",
                                 "swt.calibration names a channel this run does not have"))
     return streams, units
+
+
+def _conversion(spec: ChannelSpec) -> tuple:
+    """A channel's source field and how it becomes SI: two columns alike here hold the same
+    values."""
+    return spec.topic, spec.field, spec.unit, spec.scale, spec.offset, spec.zero, spec.zero_value
+
+
+#: ``run.derivation["dp_n"]["method"]`` of drawbar pull read from the hub's force channel
+DP_FROM_HUB = "the hub's horizontal force channel (no drawbar-pull cell)"
+
+
+def _dp_from_hub(cmap: ChannelMap, provided: set[str]) -> dict:
+    """``{"dp_n": ...}`` when the map feeds ``dp_n`` from the source field of a wrench column
+    (a rig without a drawbar-pull cell: DP is the hub's horizontal force), else {}."""
+    dp = next((c for c in cmap.channels if c.column == "dp_n"), None)
+    if dp is None or "dp_n" not in provided:
+        return {}
+    hub = [c.column for c in cmap.channels if c.column in WRENCH_COLUMNS.values()
+           and (c.topic, c.field) == (dp.topic, dp.field)]
+    return {"dp_n": {"method": DP_FROM_HUB, "channel": f"{dp.topic}.{dp.field}",
+                     "same_as": hub}} if hub else {}
 
 
 def _check_clocks(path: Path, timing: dict[str, StreamTiming]) -> None:

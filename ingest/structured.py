@@ -18,6 +18,8 @@ from ingest.raw import RawTopic
 #: the spec MCAP form's time field: whole ns since the run start (used when the map's
 #: ``[time] column`` is not in the file)
 SPEC_TIME_NS = "t_ns"
+#: a run's sidecar of metadata records: ``<run>.run.json`` beside it
+SIDECAR_SUFFIX = ".run.json"
 
 
 def variable_name(topic: str) -> str:
@@ -79,8 +81,8 @@ def sidecar_path(path: Path) -> Path:
     ROS 2 bag folder ``bag7/`` -> ``bag7.run.json``). A stem sidecar that another run file
     of that stem would read too (``run7.h5`` and ``run7.bag``) is an IngestError."""
     path = Path(path)
-    own = path.with_name(path.name + ".run.json")
-    shared = path.with_name(path.name.split(".")[0] + ".run.json")
+    own = path.with_name(path.name + SIDECAR_SUFFIX)
+    shared = path.with_name(path.name.split(".")[0] + SIDECAR_SUFFIX)
     if own != shared and own.is_file():
         return own
     if shared.is_file():
@@ -109,14 +111,16 @@ def sidecar_records(path: Path) -> dict[str, dict]:
 
 
 def dotted_records(path: Path, items) -> dict[str, dict]:
-    """Records from flat ``"<record>.<key>" = value`` properties (TDMS properties, HDF5
-    attributes); other names are not ours and are skipped."""
+    """Records from flat ``"<record>.<key>" = value`` or ``"swt.<record>.<key>" = value``
+    properties (TDMS properties, HDF5 attributes); other names are not ours and are
+    skipped."""
     out: dict[str, dict] = {}
     for name, value in items:
-        record, dot, key = str(name).partition(".")
+        text = str(name)
+        record, dot, key = text.removeprefix("swt.").partition(".")
         if not dot or not record or not key:
             continue
-        out.setdefault(record, {})[key] = scalar(path, str(name), value)
+        out.setdefault(record, {})[key] = scalar(path, text, value)
     return out
 
 

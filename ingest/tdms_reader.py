@@ -4,7 +4,8 @@ A group is the map's topic as written (``/hub/wrench``) or as an identifier
 (``hub_wrench``). Time: the map's ``[time] column`` channel, else ``t_ns``, else the
 channels' waveform timing (``wf_start_time`` + ``wf_start_offset`` + i * ``wf_increment``,
 counted from the earliest ``wf_start_time`` in the file). Metadata: file and group
-properties named ``"<record>.<key>"``, then the sidecar ``<name>.run.json``.
+properties named ``"<record>.<key>"`` or ``"swt.<record>.<key>"``, then the sidecar
+``<name>.run.json`` (``ingest.records``).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 from ingest.channel_map import ChannelMap
 from ingest.errors import IngestError
 from ingest.raw import RawRun
-from ingest.structured import dotted_records, raw_topic, sidecar_records, time_s, variable_name
+from ingest.structured import dotted_records, raw_topic, time_s, variable_name
 
 _HINT = "the file is damaged or cut short; export it again"
 
@@ -55,8 +56,6 @@ def read_tdms(path: Path, cmap: ChannelMap) -> RawRun:
     except Exception as exc:  # noqa: BLE001 - npTDMS raises many types for damaged files
         raise IngestError(path, None, f"corrupt TDMS ({type(exc).__name__}: {exc}); "
                           f"{_HINT}") from None
-    for name, values in sidecar_records(path).items():
-        records.setdefault(name, {}).update(values)
     return RawRun(path=path, records=records, topics=topics)
 
 

@@ -22,12 +22,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from ingest.run import DP_FROM_HUB
 from run_results import oscillation as osc
 from run_results.corrections import RigCompliance, corrected_heights, tare_record
 from run_results.native import native_quantities
 from run_results.phase_average import phase_average, phase_bins
 from run_results.plausibility import plausibility_flags
-from run_results.rest_readings import rest_readings
+from run_results.rest_readings import ends_moving, rest_readings
 from run_results.result import RunResult
 from run_results.stats import QuantityStats, batch_means_se, pitch_batches, quantity_stats
 from run_results.traces import run_traces
@@ -121,11 +122,20 @@ def _frequency(hz: float) -> float | None:
 
 
 def _flags(run, window, oscillation: dict) -> list[str]:
-    flags = []
+    flags = [f for f in (run.cut_short or ends_moving(run),) if f]
     missing = [c for c in FORCE_CHANNELS if not np.isfinite(run.channels[c].to_numpy()).any()]
     if missing:
+        hint = ("; a rig without a drawbar-pull cell feeds dp_n from the hub's force channel "
+                "in its channel map (docs/channel-map.md)"
+                if "dp_n" in missing and "fx_n" not in missing else "")
         flags.append(f"no force channels ({', '.join(missing)}): forces, torque, thrust and "
-                     "resistance not reported; window found from speeds and hub height alone")
+                     "resistance not reported; window found from speeds and hub height "
+                     f"alone{hint}")
+    dp = run.derivation.get("dp_n", {})
+    if dp.get("method") == DP_FROM_HUB:
+        flags.append(f"drawbar pull from the hub's force channel {dp['channel']} (as "
+                     f"{', '.join(dp['same_as'])}; no drawbar-pull cell): DP is the hub's "
+                     "horizontal force")
     if window.diagnostics.get("shrunk_to_second_half"):
         flags.append("window shrunk to its second half: the first half drifted (slope test)")
     if window.found and not window.diagnostics.get("r_hat_ok", True):

@@ -119,3 +119,23 @@ def rest_readings(run) -> RestReadings | None:
         if last is not None:
             after[column] = last
     return RestReadings(drive_s=span, before=before, after=after)
+
+
+def ends_moving(run) -> str | None:
+    """The flag of a run that rests before its drive and not after it: the raw-run spec's run
+    ends at rest, so a file whose encoders still move at its last sample, after a rest reading
+    at its start, was cut short (``ingest.cut_short``); None otherwise. A rest counts when it
+    could give a rest reading (:data:`MIN_REST_S` beyond :data:`MARGIN_S`)."""
+    from ingest.cut_short import message
+
+    span = drive_span(run)
+    if span is None:
+        return None
+    times = [frame["t_s"].to_numpy() for frame in run.streams.values() if len(frame)]
+    t0, t1 = min(float(t[0]) for t in times), max(float(t[-1]) for t in times)
+    rest = MARGIN_S + MIN_REST_S
+    if span[0] - t0 < rest or t1 - span[1] >= rest:
+        return None
+    return message(run.source, t1, f"the run rests {span[0] - t0:.1f} s before its drive and "
+                   f"{max(t1 - span[1], 0.0):.1f} s after it (a rest reading needs {rest:g} s): "
+                   "its end-of-run rest reading is missing")

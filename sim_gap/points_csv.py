@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,11 @@ WHEEL_KEY = ("wheel_radius_m", "wheel_width_m", "grouser_count", "grouser_height
 
 class PointsFormatError(ValueError):
     """A points CSV problem: ``file:line: column: problem`` on one line."""
+
+
+class TowedTorqueWarning(UserWarning):
+    """A towed row (slip <= 0) with a torque of exactly 0: most likely the zero a paper
+    prints for a towed wheel by convention, which the diagnosis would take as measured."""
 
 
 def header_of(path: str | Path) -> list[str] | None:
@@ -161,6 +167,8 @@ def _row(path: str, number: int, header: list[str], raw: str, quantities: list[s
             row[q], row[f"{q}_se"] = np.nan, np.nan
             continue
         row[q] = _number(cell[q], where(q))
+        if q == "torque_nm" and row[q] == 0.0 and row["slip"] <= 0.0:
+            _warn_towed_torque(where(q), row["slip"])
         if not cell[spread]:
             raise PointsFormatError(f"{where(spread)}: empty, but {q!r} is given")
         value = _number(cell[spread], where(spread), 0.0)
@@ -174,6 +182,16 @@ def _row(path: str, number: int, header: list[str], raw: str, quantities: list[s
         raise PointsFormatError(f"{path}:{number}: no quantity measured on this row")
     del row["n_repeats"]
     return row
+
+
+def _warn_towed_torque(where: str, slip: float) -> None:
+    """A driven wheel at slip > 0 needs a torque > 0 (thrust T/r; Wong, Theory of Ground
+    Vehicles, ch. 4), a braked one < 0; only a towed or free-rolling wheel (slip <= 0) has
+    none applied, and a paper prints that torque as 0 by convention, not as a measurement."""
+    warnings.warn(f"{where}: exactly 0 on a towed row (slip {slip:g} <= 0): if the paper "
+                  "prints a towed wheel's torque as 0 by convention, leave the cell (and its "
+                  "_se or _sd) blank; a 0 is taken as a measured torque", TowedTorqueWarning,
+                  stacklevel=4)
 
 
 def _one_wheel_per_source(path: str, table: pd.DataFrame, numbers: list[int]) -> None:

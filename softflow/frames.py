@@ -91,7 +91,8 @@ def _image_folder(folder: Path, frames, fps: float | None) -> FrameSet:
     elif fps:
         t_s = np.arange(len(files)) / fps
     else:
-        raise FrameSourceError(f"{folder}: image names are not <t_ns>; give the frame rate (--fps)")
+        raise FrameSourceError(f"{folder}: image names are not <t_ns>; give the frame rate "
+                               "(fps=FPS)")
     a, b = _range(len(files), frames)
     imgs = [_grey(cv2.imread(str(p), cv2.IMREAD_UNCHANGED), str(p)) for p in files[a:b]]
     return FrameSet(imgs, t_s[a:b], (a, b), None, source=str(folder))
@@ -174,5 +175,6 @@ def load_frames(path: str | Path, frames: tuple[int | None, int | None] | None =
         record = json.loads(meta.read_text())
         _apply_metadata(fs, record.get("camera", {}), record.get("wheel", {}))
     if fs.px_per_m is None:
-        raise FrameSourceError(f"{path}: no scale: swt.camera px_per_m is missing; give --px-per-m")
+        raise FrameSourceError(f"{path}: no scale: swt.camera px_per_m is missing; give "
+                               "px_per_m=PX_PER_M")
     return fs

@@ -7,6 +7,7 @@ import json
 import sys
 
 from swtlab_cli import exit_codes
+from swtlab_cli.flags import as_flags
 from swtlab.atomic import write_atomically
 
 ENGINE_CHOICES = ("deform-lk", "farneback", "dis")  # softflow.flow_engine.ENGINES, kept light
@@ -41,7 +42,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--dask", metavar="SCHEDULER_ADDRESS",
                    help="compute the frame pairs' flows on this dask.distributed scheduler's "
                         "workers (e.g. tcp://10.0.0.5:8786; docs/scale-out.md)")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, cli_parser=p)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -54,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         client = connect(args.dask) if args.dask else None
     except ValueError as exc:
-        print(f"swtlab flow: {exc}", file=sys.stderr)
+        print(f"swtlab flow: {as_flags(str(exc), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     try:
         fs = load_frames(args.source, args.frames, args.px_per_m, args.fps)
@@ -63,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
                                 args.engine, frame_range=fs.frame_range, source=fs.source,
                                 client=client)
     except (FrameSourceError, WheelNotFoundError, OSError) as exc:
-        print(f"swtlab flow: {exc}", file=sys.stderr)
+        print(f"swtlab flow: {as_flags(str(exc), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     except FlowMeasurementError as exc:
         print(f"swtlab flow: {fs.source}: soil flow not measured: {exc}", file=sys.stderr)

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from swtlab.pipeline.process import CAMPAIGN_SETTINGS
 from swtlab_cli import exit_codes
+from swtlab_cli.flags import as_flags
 from swtlab_cli.progress import progress
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -66,7 +67,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                             "(e.g. tcp://10.0.0.5:8786; they must see CAMPAIGN at the same "
                             "path); this process stores them (docs/scale-out.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, cli_parser=parser)
 
 
 def _jobs(text: str) -> int:
@@ -77,6 +78,22 @@ def _jobs(text: str) -> int:
     if jobs < 1:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number >= 1")
     return jobs
+
+
+def _where(db: str) -> str:
+    """``--db`` as given and, for a SQLite file, the file it resolves to (a relative path
+    under ``sqlite:///`` said to be one)."""
+    from traceability.database import database_file
+
+    found = database_file(db)
+    if found is None:
+        return db
+    path, relative = found
+    if not relative:
+        return f"{db} = {path}"
+    meant = "/" + db.partition(":///")[2]
+    return (f"{db} = {path} (sqlite:/// and a relative path: from the working directory; "
+            f"an absolute path takes four slashes: sqlite:///{meant})")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -101,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
                                    budget=budget_params(args.campaign))
         client = connect(args.dask) if args.dask else None
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
-        print(f"swtlab process: {error}", file=sys.stderr)
+        print(f"swtlab process: {as_flags(str(error), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     parameters = settings.parameters()
     params_hash = params_sha256(parameters)
@@ -172,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
         for line in statuses[status]:
             print(f"  {status}: {line}")
     for line in failed:
-        print(f"  failed: {line}")
+        print(f"  failed: {as_flags(line, args)}")
     for line in missing:
         print(f"  missing: {line}: stored, but no longer in {args.campaign}; its results stay "
               "listed, marked raw_file_missing")
@@ -181,5 +198,5 @@ def run(args: argparse.Namespace) -> int:
               + (f", not measured in {len(flow_failed)}" if flow_failed else ""))
     for line in flow_failed:
         print(f"  soil flow not measured: {line}")
-    print(f"database: {args.db}  (list the results: swtlab results --db {args.db})")
+    print(f"database: {_where(args.db)}  (list the results: swtlab results --db {args.db})")
     return exit_codes.OK if done + up_to_date else exit_codes.BAD_INPUT

@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 from swtlab_cli import exit_codes
+from swtlab_cli.flags import as_flags
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -29,7 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", action="store_true",
                         help="print the pages written as JSON ({campaign, path, bytes})")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, cli_parser=parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -55,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
         else:
             pages = write_reports(args.db, args.output, bar)
     except LookupError as error:
-        print(f"swtlab report: {error.args[0]}", file=sys.stderr)
+        print(f"swtlab report: {as_flags(str(error.args[0]), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     except SQLAlchemyError as error:
         print(f"swtlab report: {args.db}: cannot read the database "

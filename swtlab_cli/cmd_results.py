@@ -64,6 +64,42 @@ def failed_rows(failures) -> pd.DataFrame:
                                      "failure_reason"])
 
 
+#: the uncertainty each shown value is rounded by (GUM 7.2.6), per table; uncertainties
+#: themselves show two significant digits
+SUMMARY_U = {f"{q}_mean": f"{q}_u95" for q in ("slip", "dp_n", "torque_nm", "sinkage_m",
+                                               "resistance_n")}
+SUMMARY_U.update({"image_slip_mean": "image_slip_u95", "dp_n_se": "dp_n_se"})
+TOWED_U = {"towed_resistance_n": "towed_resistance_se_n",
+           "powered_resistance_at_zero_slip_n": "powered_resistance_se_n"}
+REPLICATE_U = {"mean": "within_u", "replicate_sd": "replicate_sd", "within_u": "within_u"}
+
+
+def shown(frame: pd.DataFrame, uncertainty: dict[str, str]) -> pd.DataFrame:
+    """``frame`` as text for a person: each value of ``uncertainty``'s keys to the decimal of
+    its row's uncertainty column (two significant digits; ``swtlab.rounding``), the
+    uncertainty columns to two significant digits, other numbers to four, NaN empty."""
+    from swtlab.rounding import plain, value_and_u
+
+    us = set(uncertainty.values())
+    out = {}
+    for column in frame.columns:
+        values = frame[column]
+        if column in uncertainty and uncertainty[column] in frame:
+            out[column] = [value_and_u(_float(v), _float(u))[0]
+                           for v, u in zip(values, frame[uncertainty[column]])]
+        elif column in us:
+            out[column] = [value_and_u(None, _float(u))[1] for u in values]
+        elif pd.api.types.is_float_dtype(values):
+            out[column] = [plain(_float(v)) for v in values]
+        else:
+            out[column] = ["" if pd.isna(v) else str(v) for v in values]
+    return pd.DataFrame(out, columns=frame.columns)
+
+
+def _float(value) -> float | None:
+    return None if value is None or pd.isna(value) else float(value)
+
+
 def write_parquet(frame: pd.DataFrame, path: Path) -> None:
     """``frame`` to a Parquet file (pyarrow), atomically; ``pd.read_parquet`` gives it back
     with its dtypes (pandas metadata in the file)."""
@@ -116,14 +152,13 @@ def run(args: argparse.Namespace) -> int:
     elif args.json:
         print(every.to_json(orient="records", indent=1))
     elif args.towed:
-        print(table[TOWED_COLUMNS].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+        print(shown(table[TOWED_COLUMNS], TOWED_U).to_string(index=False))
     elif args.replicates:
         columns = [c for c in REPLICATE_COLUMNS if c in table.columns]
-        print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+        print(shown(table[columns], REPLICATE_U).to_string(index=False))
     else:
         columns = [c for c in SUMMARY_COLUMNS if c in every.columns]
-        print(every[columns].to_string(index=False, na_rep="",
-                                       float_format=lambda v: f"{v:.4g}"))
+        print(shown(every[columns], SUMMARY_U).to_string(index=False))
         for row in failed.itertuples():
             print(f"failed: {row.run_id}: {row.flags} [{row.failure_type}]")
     return exit_codes.OK

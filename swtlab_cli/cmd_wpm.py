@@ -11,6 +11,7 @@ import sys
 import warnings
 
 from swtlab_cli import exit_codes
+from swtlab_cli.flags import as_flags
 from wpm_export.schema import UNITS
 
 #: option -> quantity of the inverse query
@@ -55,6 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     q.add_argument("--allow-extrapolation", action="store_true",
                    help="answer for a load outside the tested loads (linear, with a warning)")
     q.add_argument("--json", action="store_true", help="one JSON object on standard output")
+<<<<<<< HEAD
     q.set_defaults(func=run_query)
     f = sub.add_parser(
         "fmu", help="the wheel as an FMI 2.0 co-simulation FMU (docs/wpm-csv.md)",
@@ -82,6 +84,9 @@ def run_fmu(args: argparse.Namespace) -> int:
     print(f"{made['fmu']}: FMI 2.0 co-simulation FMU of {made['wheel']} on {made['soil']}, "
           f"multipass {made['multipass']}")
     return exit_codes.OK
+=======
+    q.set_defaults(func=run_query, cli_parser=q)
+>>>>>>> ingest
 
 
 def _inverse(wpm, args, chosen: dict) -> dict:
@@ -209,7 +214,7 @@ def run_query(args: argparse.Namespace) -> int:
             warnings.simplefilter("always")
             answer = (_values if args.slip is not None else _inverse)(wpm, args, chosen)
     except (OSError, WpmFormatError, WpmSelectionError, FittingError) as exc:
-        print(f"swtlab wpm: {exc}", file=sys.stderr)
+        print(f"swtlab wpm: {as_flags(str(exc), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     for w in {str(w.message) for w in caught}:
         print(f"swtlab wpm: warning: {w}", file=sys.stderr)

@@ -229,11 +229,21 @@ def test_wrong_message_type_on_the_force_topic_names_the_channel(tmp_path, short
     assert "(geometry_msgs/msg/WrenchStamped) has no field 'header'" in err.problem
 
 
-def test_truncated_rig_bag_is_one_line_error(tmp_path, short_log):
+def test_rig_bag_cut_short_reads_its_whole_records(tmp_path, short_log):
+    """A bag cut in half has lost its index: its whole records are read (the motion rows the
+    whole bag holds up to there) and the run says where the file ends."""
+    whole = ingest.read_run(_write_ros1(tmp_path / "whole" / "10_5_0_1.bag",
+                                        _records(*short_log)), CMU_MAP)
     bag = _write_ros1(tmp_path / "10_5_0_1.bag", _records(*short_log))
     data = bag.read_bytes()
     bag.write_bytes(data[: len(data) // 2])
-    assert "damaged or cut short" in _error(bag).problem
+    run = ingest.read_run(bag, CMU_MAP)
+    want, got = whole.streams["/cmu/motion"], run.streams["/cmu/motion"]
+    assert 0 < len(got) < len(want)
+    pd.testing.assert_frame_equal(got, want.iloc[:len(got)])
+    assert run.cut_short == (f"10_5_0_1.bag: file ends at t = {got['t_s'].iloc[-1]:.3f} s "
+                             "(cut short?): ROS 1 bag without its index (the recorder stopped "
+                             "mid-write); the messages of its whole chunks and records are read")
 
 
 def test_unknown_message_type_is_refused_naming_the_topic(tmp_path, short_log):

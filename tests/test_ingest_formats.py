@@ -95,7 +95,7 @@ def _error(path, cmap=None) -> ingest.IngestError:
     return caught.value
 
 
-@pytest.mark.parametrize("fmt", ["hdf5", "mat5", "mat73", "tdms", "rosbag1"])
+@pytest.mark.parametrize("fmt", ["hdf5", "mat5", "mat73", "tdms"])  # bags: test_ingest_cut_short
 def test_truncated_file_is_one_line_error(fmt, tmp_path, spec_run):
     write, cmap = CASES[fmt]
     path = write(spec_run, tmp_path)

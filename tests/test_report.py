@@ -96,8 +96,10 @@ def test_page_lists_every_run_with_its_status_and_reasons(small):
     url, page, text = small
     with open_database(url)() as session:
         results = latest_results(session)
-    rows = {re.search(r">([^<]+)</a>", row).group(1): row
-            for row in re.findall(r"<tr class=\"(?:ok|flagged|no_stable_phase)\">(.*?)</tr>", text)}
+    rows = {re.search(r">([^<]+)</a>", row).group(1): row + reasons  # reasons: under the row
+            for row, reasons in re.findall(r"<tr class=\"(?:ok|flagged|no_stable_phase)\">(.*?)"
+                                           r"</tr>(?:<tr class=\"\w+ reasons\">(.*?)</tr>)?",
+                                           text)}
     assert set(results["run_id"]) <= set(rows) and len(results) == 20
     assert 'class="status flagged"' in rows[FLAGGED_RUN] and FLAG in unescape(rows[FLAGGED_RUN])
     reason = results.set_index("run_id").loc[NO_STABLE_RUN, "no_window_reason"]
@@ -285,7 +287,7 @@ def test_cli_writes_one_page_per_campaign(small, tmp_path, capsys, fast_timeseri
     assert _cli(["--db", url, "-o", str(tmp_path / "one.html"), "--campaign",
                  "second run-in"]) == 0
     assert "second run-in" in capsys.readouterr().out and (tmp_path / "one.html").is_file()
-    with pytest.raises(LookupError, match="name one with --campaign"):
+    with pytest.raises(LookupError, match="name one with campaign='"):
         write_report(url, tmp_path / "x.html")
 
 
@@ -322,6 +324,19 @@ def test_run_table_shows_each_runs_stored_standard_uncertainty(small):
                                ("u(slip) [%]", "slip", 100.0)):
         assert float(cells[columns.index(column)]) == pytest.approx(
             stored.loc["L180_MP0_SC_s+020", f"{key}_u"] * scale, rel=0.05)  # 2 digits shown
+    # GUM 7.2.6 in every row: u with two significant digits, its mean to the same decimal
+    body = re.search(r"<section id=\"runs\">.*?<tbody>(.*?)</tbody>", text).group(1)
+    checked = 0
+    for row in re.findall(r'<tr class="(?:ok|flagged)">(.*?)</tr>', body):
+        cells = re.findall(r"<td[^>]*>(.*?)</td>", row)
+        for name in ("slip", "DP", "torque", "sinkage"):
+            i = next(j for j, c in enumerate(columns) if c.startswith(f"{name} ["))
+            mean, u = cells[i], cells[i + 1]
+            digits = u.lstrip("0.")
+            assert len(digits) == 2 or (len(digits) == 3 and "." not in u), (name, u)
+            assert len(mean.partition(".")[2]) == len(u.partition(".")[2]), (name, mean, u)
+            checked += 1
+    assert checked == 4 * 19
 
 
 def test_hidden_error_bars_get_a_note_and_repeatability_follows_the_run_table(small):

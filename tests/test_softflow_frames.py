@@ -61,7 +61,7 @@ def test_video_with_times_csv(tmp_path):
 def test_plain_image_folder_needs_scale_and_times(tmp_path):
     for i, img in enumerate(_images(3)):
         cv2.imwrite(str(tmp_path / f"img{i}.png"), img)
-    with pytest.raises(FrameSourceError, match="--fps"):
+    with pytest.raises(FrameSourceError, match=r"\(fps=FPS\)"):
         load_frames(tmp_path, px_per_m=1000)
     with pytest.raises(FrameSourceError, match="px_per_m"):
         load_frames(tmp_path, fps=50)

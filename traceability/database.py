@@ -67,6 +67,17 @@ def _sqlite_file(url: URL) -> Path | None:
     return Path(url.database)
 
 
+def database_file(text: str) -> tuple[Path, bool] | None:
+    """The SQLite file a ``--db`` value names, resolved, and whether the URL gave it relative
+    to the working directory (``sqlite:///out/x.sqlite``: three slashes, then a relative
+    path; ``sqlite:////tmp/x.sqlite`` is absolute); None for other databases."""
+    try:
+        path = _sqlite_file(make_url(database_url(text)))
+    except ArgumentError:
+        return None
+    return None if path is None else (path.resolve(), not path.is_absolute())
+
+
 def _shown(url: URL) -> str:
     """The URL to name in a message: without its password."""
     return url.render_as_string(hide_password=True)

@@ -101,7 +101,7 @@ def _claimed(db_run: Run, path: str, campaign: str) -> RunIdClaimed:
     return RunIdClaimed(
         f"{path}: claims run_id {db_run.run_id!r} of campaign {campaign!r}, already stored "
         f"from {_current(db_run).path}; give one of them another run_id, or pass "
-        "--allow-run-id-reuse to store this file as that run's new version")
+        "allow_run_id_reuse=True to store this file as that run's new version")
 
 
 def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, Any],
