@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from threadpoolctl import threadpool_limits
 
 
 from sim_gap import candidates as cands
@@ -79,7 +80,9 @@ def testable(sim: Simulated, points: pd.DataFrame, laws: dict[str, tuple[str, ..
 
 def _fit(args) -> MapFit:
     sim, c, points, sig, settings, start = args
-    return fit_map(sim, c, points, sig, param_prior(c, sim.model), start, settings.max_nfev)
+    with threadpool_limits(limits=1, user_api="blas"):  # in a worker process too
+        return fit_map(sim, c, points, sig, param_prior(c, sim.model), start,
+                       settings.max_nfev)
 
 
 def _pair_start(c: cands.Candidate, singles: dict[str, MapFit]) -> dict[str, float]:
@@ -157,8 +160,15 @@ def _fit_noise(points: pd.DataFrame, sig: dict[str, np.ndarray], radius_m: float
 def diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None = None,
              settings: Settings | None = None) -> dict:
     """The gap report's content (docs/gap-report.md) for measured ``points`` against ``sim``;
-    ``effects``: the candidate effects (default: every effect the simulation lacks)."""
-    settings = settings or Settings()
+    ``effects``: the candidate effects (default: every effect the simulation lacks). BLAS
+    runs on one thread: its matrices (a few hundred entries) factor faster alone than split
+    over cores that the candidate fits already keep busy."""
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _diagnose(points, sim, effects, settings or Settings())
+
+
+def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
+              settings: Settings) -> dict:
     asked = [e for e in (effects or sim.missing_effects()) if e in sim.missing_effects()]
     admitted, excluded = admissible(asked, points)
     effects_ok, untestable = testable(sim, points,
