@@ -54,7 +54,7 @@ def read_mcap(path: Path, topics: set[str]) -> RawRun:
         raise
     except OSError as exc:
         raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
-    except Exception as exc:  # noqa: BLE001 - mcap raises many types for damaged files
+    except Exception as exc:  # mcap raises many types for damaged files
         raise IngestError(path, None, f"corrupt or truncated MCAP "
                           f"({type(exc).__name__}: {exc}); {_HINT}") from None
     raw_topics = {topic: _decode_blocks(path, topic, data) for topic, data in blocks.items()}
