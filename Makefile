@@ -43,9 +43,11 @@ demo: $(STAMP)
 	@echo "         one row per run in $(OUT)/results.csv, WPM curves in $(OUT)/wpm.csv,"
 	@echo "         sim-to-real gap report in $(OUT)/gap.html"
 
-# One worker per core (pytest-xdist); a test file stays on one worker, so module fixtures run once.
+# Lint first (seconds), then one worker per core (pytest-xdist); a test file stays on one
+# worker, so module fixtures run once. The 15 slowest tests are printed to keep the suite fast.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n auto --dist loadfile
+	$(BIN)/ruff check .
+	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=15
 
 bench: $(STAMP)
 	$(BIN)/python -m bench

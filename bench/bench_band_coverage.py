@@ -23,14 +23,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-import swtlab  # noqa: E402
-from fitting import band, curves_by_load, fit_results, from_run_results  # noqa: E402
-from fitting import interpolate_load  # noqa: E402
-from terramechanics.testbed_law import ModelLaw  # noqa: E402
-from validation.coverage import wilson  # noqa: E402
-from test_fitting_synthetic import MODEL  # noqa: E402
-from virtual_testbed import RunCondition, generate_campaign  # noqa: E402
-from virtual_testbed.sample_campaign import SAMPLE_RATES  # noqa: E402
+import swtlab
+from fitting import band, curves_by_load, fit_results, from_run_results
+from fitting import interpolate_load
+from terramechanics.testbed_law import ModelLaw
+from validation.coverage import wilson
+from test_fitting_synthetic import MODEL
+from virtual_testbed import RunCondition, generate_campaign
+from virtual_testbed.sample_campaign import SAMPLE_RATES
 
 SEEDS, QUICK_SEEDS = range(30, 50), range(30, 34)
 TESTED_N, HELD_OUT_N = (70.0, 180.0, 300.0), 120.0

@@ -1,5 +1,5 @@
 """CMU smooth wheel on real sand (27 straight runs, slip -1 ... 0.9): soil calibrated with
-priors (sim_gap.calibrate) with one slip band held out at a time (sim_gap.holdout); goal:
+priors (sim_gap.calibrate) with one slip band held out at a time (validation.holdout); goal:
 held-out DP RMSE at most 10 % of the measured DP range. For reference, the DP RMSE of the
 model with the CMU authors' own soil (not fitted; terramechanics/soil_tables)."""
 
@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 import terramechanics as tm
-from sim_gap.holdout import HOLDOUT_BAND_EDGES, holdout_dp, holdout_summary
+from validation.holdout import HOLDOUT_BAND_EDGES, holdout_dp, holdout_summary
 from sim_gap.measured import from_cmu_smooth_runs
 from sim_gap.priors import published_soils
 

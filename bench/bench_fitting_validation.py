@@ -17,9 +17,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
-from fitting import fit_results, validate_load_interpolation  # noqa: E402
-from test_fitting_sample_truth import truth_results_table  # noqa: E402
-from test_fitting_synthetic import model_results_table, sample_like_table  # noqa: E402
+from fitting import fit_results, validate_load_interpolation
+from test_fitting_sample_truth import truth_results_table
+from test_fitting_synthetic import model_results_table, sample_like_table
 
 QUANTITIES = ("dp_n", "torque_nm", "sinkage_m", "resistance_n", "dp_over_w")
 

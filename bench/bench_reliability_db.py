@@ -126,7 +126,7 @@ def _results_stored(path: Path) -> int:
     try:
         with engine.connect() as connection:
             return connection.exec_driver_sql("SELECT count(*) FROM run_result").scalar()
-    except Exception:  # noqa: BLE001 - killed before the table existed
+    except Exception:  # killed before the table existed
         return 0
     finally:
         engine.dispose()

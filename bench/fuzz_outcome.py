@@ -43,7 +43,7 @@ class Outcome:
     detail: str = ""
 
 
-def _alarm(signum, frame):  # noqa: ARG001 - signal handler signature
+def _alarm(signum, frame):  # signal handler signature
     raise Hang()
 
 
@@ -90,7 +90,7 @@ def run_case(case: Case, time_limit_s: float = TIME_LIMIT_S) -> Outcome:
         try:
             try:
                 path, cmap = case.write(Path(tmp))
-            except Exception as error:  # noqa: BLE001 - the map itself may be unparseable
+            except Exception as error:  # the map itself may be unparseable
                 return Outcome("refused", f"not written: {type(error).__name__}")
             settings = _settings(cmap)
             if isinstance(settings, Outcome):
@@ -123,5 +123,5 @@ def _settings(cmap: str | None):
         return ProcessSettings(channel_map=cmap, max_frames=0)
     except ingest.IngestError as error:
         return Outcome("refused", str(error))
-    except Exception as error:  # noqa: BLE001 - anything else from a map is a fault
+    except Exception as error:  # anything else from a map is a fault
         return Outcome("unhandled", f"channel map: {type(error).__name__}: {error}")

@@ -20,12 +20,12 @@ import matplotlib
 
 matplotlib.use("Agg")  # no display, no GUI toolkit: the page is rendered headless
 
-import numpy as np  # noqa: E402
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from PIL import Image  # noqa: E402
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from PIL import Image
 
-from campaign_report.style import LOAD_COLOURS  # noqa: E402
+from campaign_report.style import LOAD_COLOURS
 
 FULL_DPI = 100
 #: matplotlib settings the page's figures are made and drawn with: unhinted glyphs (no

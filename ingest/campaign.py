@@ -58,7 +58,7 @@ def read_campaign(root: str | Path,
             result.runs.append(read_run(path, cmap))
         except IngestError as exc:
             result.failures.append(exc)
-        except Exception as exc:  # noqa: BLE001 - one line per run, the batch goes on
+        except Exception as exc:  # one line per run, the batch goes on
             result.failures.append(IngestError(path, None, f"internal error while reading "
                                                f"({type(exc).__name__}: {exc}); please report it"))
     return result

@@ -62,7 +62,7 @@ def _load_v5(path: Path) -> dict:
         return loadmat(path, simplify_cells=True)
     except OSError as exc:
         raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
-    except Exception as exc:  # noqa: BLE001 - scipy raises many types for damaged files
+    except Exception as exc:  # scipy raises many types for damaged files
         raise IngestError(path, None, f"corrupt MATLAB v5 file ({type(exc).__name__}: "
                           f"{exc}); {_HINT}") from None
 

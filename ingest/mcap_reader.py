@@ -54,7 +54,7 @@ def read_mcap(path: Path, topics: set[str]) -> RawRun:
         raise
     except OSError as exc:
         raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
-    except Exception as exc:  # noqa: BLE001 - mcap raises many types for damaged files
+    except Exception as exc:  # mcap raises many types for damaged files
         records, blocks, images = _recover(path, topics, exc)
         cut = CUT_MCAP
     raw_topics = {topic: _decode_blocks(path, topic, data) for topic, data in blocks.items()}
@@ -98,7 +98,7 @@ def _recover(path: Path, topics: set[str], error: Exception) -> tuple[dict, dict
                 found += breakup_chunk(record, True) if isinstance(record, Chunk) else [record]
                 done = stream.tell()
             at_end = False  # a footer: the file is whole, the first reading failed elsewhere
-        except Exception:  # noqa: BLE001 - where it stopped decides
+        except Exception:
             at_end = stream.tell() >= size
             stream.seek(done)
             found += _cut_chunk(stream.read()) if at_end else []
@@ -131,7 +131,7 @@ def _cut_chunk(tail: bytes) -> list:
             data = lz4.frame.LZ4FrameDecompressor().decompress(data)
         elif compression:
             return []
-    except Exception:  # noqa: BLE001 - too little of the chunk to read
+    except Exception:
         return []
     out, at = [], 0
     readers = {Opcode.SCHEMA: Schema.read, Opcode.CHANNEL: Channel.read}

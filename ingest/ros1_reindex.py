@@ -28,7 +28,7 @@ def needs_reindex(path: Path) -> bool:
         src.readline()
         try:
             index_pos = Header.read(src, RecordType.BAGHEADER).get_uint64("index_pos")
-        except Exception:  # noqa: BLE001 - no header: rosbags names the damage
+        except Exception:
             return False
     return index_pos == 0 or index_pos >= path.stat().st_size
 
@@ -75,7 +75,7 @@ def _scan(path: Path) -> tuple[dict, list]:
                 decompressor = make()
                 try:
                     inner = data if decompressor is None else decompressor.decompress(data)
-                except Exception:  # noqa: BLE001 - a chunk too short to decompress
+                except Exception:
                     break
                 _inner(BytesIO(inner), connections, messages)
             elif op == RecordType.CONNECTION and whole:
@@ -93,7 +93,7 @@ def _record(src):
     try:
         header = Header.read(src)
         size = read_uint32(src)
-    except Exception:  # noqa: BLE001 - the end of the file (or of a cut record)
+    except Exception:
         return None, b"", False
     data = src.read(size)
     return header, data, len(data) == size

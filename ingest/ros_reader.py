@@ -149,7 +149,7 @@ def _messages(path: Path, bag: Path, topics: set[str]):
         raise
     except OSError as exc:
         raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
-    except Exception as exc:  # noqa: BLE001 - rosbags raises many types for damaged bags
+    except Exception as exc:  # rosbags raises many types for damaged bags
         raise IngestError(path, None, f"corrupt or unreadable ROS bag ({type(exc).__name__}: "
                           f"{exc}); the bag is damaged or cut short (try `rosbag reindex`)") \
             from None

@@ -31,7 +31,7 @@ def vector(path: Path, where: str, value: Any) -> np.ndarray:
     """A 1-D numeric array (a MATLAB 1xN or Nx1 matrix flattened), else a one-line error."""
     try:
         array = np.asarray(value)
-    except Exception as exc:  # noqa: BLE001 - any unreadable array is one error
+    except Exception as exc:  # any unreadable array is one error
         raise IngestError(path, where, f"cannot read as an array ({exc})") from None
     if array.ndim > 1 and sorted(array.shape)[:-1] != [1] * (array.ndim - 1):
         raise IngestError(path, where, f"shape {array.shape}; a channel must be one vector")

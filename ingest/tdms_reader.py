@@ -53,7 +53,7 @@ def read_tdms(path: Path, cmap: ChannelMap) -> RawRun:
         raise
     except OSError as exc:
         raise IngestError(path, None, f"cannot read file: {exc.strerror or exc}") from None
-    except Exception as exc:  # noqa: BLE001 - npTDMS raises many types for damaged files
+    except Exception as exc:  # npTDMS raises many types for damaged files
         raise IngestError(path, None, f"corrupt TDMS ({type(exc).__name__}: {exc}); "
                           f"{_HINT}") from None
     return RawRun(path=path, records=records, topics=topics)

@@ -145,7 +145,7 @@ def from_wpm(wpm: WheelPerformanceModule, gravity_mps2: float | None = None) -> 
     g = gravity_mps2 or float(wpm.header.get("gravity_mps2", G0_MPS2))
     rows = []
     for soil, name, mp in wpm.sets():
-        by_q = wpm._sets[(soil, name, mp)]  # noqa: SLF001 - the reader's own index
+        by_q = wpm._sets[(soil, name, mp)]  # the reader's own index
         for load in sorted({load for curves in by_q.values() for load in curves}):
             curves = {q: by_q[q][load] for q in QUANTITIES if load in by_q.get(q, {})}
             lo = max(c.slip_min for c in curves.values())

@@ -10,11 +10,11 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from softflow.flow_result import FlowResult  # noqa: E402
-from swtlab.atomic import atomic_file  # noqa: E402
+from softflow.flow_result import FlowResult
+from swtlab.atomic import atomic_file
 
 
 def magnitude_map(result: FlowResult, frame: np.ndarray):

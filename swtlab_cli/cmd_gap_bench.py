@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
+import sys
 import tempfile
 from dataclasses import replace
 from pathlib import Path
@@ -48,7 +50,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def _checkout_on_path() -> bool:
+    """The bench's generators (``validation``, ``virtual_testbed``) live in the repository and
+    are not installed with swtlab: put the checkout this command runs from (an editable
+    install) on the import path. False when there is none (swtlab installed from a wheel)."""
+    root = Path(__file__).resolve().parents[1]
+    if (root / "validation").is_dir() and (root / "virtual_testbed").is_dir():
+        if str(root) not in sys.path:
+            sys.path.insert(0, str(root))
+        return True
+    return importlib.util.find_spec("validation") is not None
+
+
 def run(args: argparse.Namespace) -> int:
+    if not _checkout_on_path():
+        print("swtlab gap-bench: the bench's generators (validation, virtual_testbed) are not "
+              "installed with swtlab; run it from a swtlab repository checkout "
+              "(pip install -e .)")
+        return exit_codes.USAGE
     from swtlab.cluster import connect
     from validation.gap_bench import FAST_DESIGN, Design, format_score, run_bench
 

@@ -43,7 +43,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "tested ones are interpolated across load on curve values.")
     q._negative_number_matcher = re.compile(r"^-\d*\.?\d")
     q.add_argument("wpm_csv", help="WPM CSV file")
-    q.add_argument("--load", type=finite, required=True, help="wheel load in N")
+    q.add_argument("--load", dest="load_n", type=finite, required=True, help="wheel load in N")
     ask = q.add_mutually_exclusive_group(required=True)
     ask.add_argument("--dp", type=finite, help="required drawbar pull in N")
     ask.add_argument("--torque", type=finite, help="required torque in N*m")
@@ -56,8 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     q.add_argument("--allow-extrapolation", action="store_true",
                    help="answer for a load outside the tested loads (linear, with a warning)")
     q.add_argument("--json", action="store_true", help="one JSON object on standard output")
-<<<<<<< HEAD
-    q.set_defaults(func=run_query)
+    q.set_defaults(func=run_query, cli_parser=q)
     f = sub.add_parser(
         "fmu", help="the wheel as an FMI 2.0 co-simulation FMU (docs/wpm-csv.md)",
         description="Write an FMU of one curve set: inputs wheel load and slip, outputs DP, "
@@ -68,7 +67,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     f.add_argument("--soil", help="soil of the curves (needed when the file has several)")
     f.add_argument("--wheel", help="wheel of the curves (needed when the file has several)")
     f.add_argument("--multipass", type=int, help="multipass index of the curves")
-    f.set_defaults(func=run_fmu)
+    f.set_defaults(func=run_fmu, cli_parser=f)
 
 
 def run_fmu(args: argparse.Namespace) -> int:
@@ -84,9 +83,6 @@ def run_fmu(args: argparse.Namespace) -> int:
     print(f"{made['fmu']}: FMI 2.0 co-simulation FMU of {made['wheel']} on {made['soil']}, "
           f"multipass {made['multipass']}")
     return exit_codes.OK
-=======
-    q.set_defaults(func=run_query, cli_parser=q)
->>>>>>> ingest
 
 
 def _inverse(wpm, args, chosen: dict) -> dict:
@@ -95,8 +91,8 @@ def _inverse(wpm, args, chosen: dict) -> dict:
     option = next(o for o in TARGETS if getattr(args, o) is not None)
     quantity, target = TARGETS[option], getattr(args, option)
     extrapolate = {"allow_extrapolation": args.allow_extrapolation}
-    found = wpm.slip_for(quantity, target, args.load, **chosen, **extrapolate)
-    curve = wpm.curve(quantity, args.load, **chosen, **extrapolate)
+    found = wpm.slip_for(quantity, target, args.load_n, **chosen, **extrapolate)
+    curve = wpm.curve(quantity, args.load_n, **chosen, **extrapolate)
     slip = float(found.slip)
     uncertainty = {"slip_conf_half95": None, "slip_pred_half95": None,
                    "value_conf_half95": None, "value_pred_half95": None}
@@ -105,7 +101,7 @@ def _inverse(wpm, args, chosen: dict) -> dict:
         _, conf, pred = band(curve, at)
         uncertainty.update(value_conf_half95=float(conf), value_pred_half95=float(pred))
         if str(found.status) == "ok":
-            slip_conf, slip_pred = wpm.slip_band(quantity, slip, args.load, **chosen,
+            slip_conf, slip_pred = wpm.slip_band(quantity, slip, args.load_n, **chosen,
                                                  **extrapolate)
             uncertainty.update(slip_conf_half95=_finite(slip_conf),
                                slip_pred_half95=_finite(slip_pred))
@@ -139,7 +135,7 @@ def _values(wpm, args, chosen: dict) -> dict:
     out = {"slip": args.slip, "values": {}, "units": {}, "outside_slip_range": {},
            "conf_half95": {}, "pred_half95": {}}
     for quantity in wpm.quantities(**chosen):
-        curve = wpm.curve(quantity, args.load, **chosen,
+        curve = wpm.curve(quantity, args.load_n, **chosen,
                           allow_extrapolation=args.allow_extrapolation)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -219,7 +215,7 @@ def run_query(args: argparse.Namespace) -> int:
     for w in {str(w.message) for w in caught}:
         print(f"swtlab wpm: warning: {w}", file=sys.stderr)
     answer = {"file": args.wpm_csv, "soil": soil, "wheel": wheel, "multipass": multipass,
-              "load_n": args.load, **answer}
+              "load_n": args.load_n, **answer}
     if args.json:
         print(json.dumps(answer))
     else:

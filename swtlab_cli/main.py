@@ -93,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("swtlab: interrupted", file=sys.stderr)
         return 130
-    except Exception as exc:  # noqa: BLE001 - last line of defence, one line for the user
+    except Exception as exc:  # last line of defence, one line for the user
         if _is_database_error(exc):
             print(f"swtlab {args.command}: {exc}", file=sys.stderr)
             return exit_codes.BAD_INPUT

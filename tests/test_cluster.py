@@ -1,6 +1,7 @@
 """swtlab.cluster on a real two-worker ``dask.distributed.LocalCluster``: each task runs
 numba, OpenCV and BLAS on its share of its host's cores; ``swtlab flow --dask`` (frame
-pairs) and the gap-bench's campaigns on the cluster give the numbers of the local run."""
+pairs) on the cluster gives the numbers of the local run (the gap bench's campaigns on the
+cluster: tests/test_gap_bench.py)."""
 
 from __future__ import annotations
 
@@ -13,8 +14,6 @@ import pytest
 from softflow.field_analysis import analyse_frames
 from swtlab.cluster import map_in_order, task_slots
 from swtlab_cli.main import main
-from swtlab.domain.gravity import G0_MPS2
-from validation.gap_bench import Design, run_bench
 from virtual_testbed.flow_render import FlowScene, render_flow, write_flow_render
 
 distributed = pytest.importorskip("distributed")
@@ -95,28 +94,3 @@ def test_flow_with_an_unreachable_scheduler_is_one_line_and_exit_3(render, tmp_p
     err = capsys.readouterr().err.strip()
     assert err.startswith("swtlab flow: --dask tcp://127.0.0.1:9: cannot reach")
     assert len(err.splitlines()) == 1
-
-
-def _files(folder) -> dict:
-    """Every file under ``folder`` (relative path: bytes, ``folder`` itself named WORK), the
-    databases and the scores (they hold when each was made) left out."""
-    return {str(p.relative_to(folder)): p.read_bytes().replace(str(folder).encode(), b"WORK")
-            for p in sorted(folder.rglob("*"))
-            if p.is_file() and p.suffix != ".sqlite" and not p.name.startswith("score-")}
-
-
-def test_a_gap_bench_campaign_on_the_cluster_is_the_local_one(client, tmp_path):
-    """One tiny campaign (8 runs; held-out laws: one law per family, the fastest diagnosis)
-    made, processed and diagnosed in tasks on the cluster: every file (raw runs, truth,
-    labels, laws, the gap report) and the score are the local run's."""
-    design = Design(loads_n=(80.0, 250.0), slips=(0.15, 0.65), gravity_mps2=(G0_MPS2,))
-    runs = {"seed": 4, "design": design, "boot": 5, "truth_laws": "held-out"}
-    here = run_bench(1, workdir=tmp_path / "here", jobs=1, **runs)
-    there = run_bench(1, workdir=tmp_path / "there", client=client, **runs)
-    files = _files(tmp_path / "here")
-    assert len([f for f in files if f.endswith(".mcap")]) == 8
-    assert b"sqlite:///WORK/c000/swtlab.sqlite" in files["c000/gap-held-out.json"]
-    assert _files(tmp_path / "there") == files
-    assert there["timing_s"]["jobs"] == 2 and here["n"] == 1
-    assert ({k: v for k, v in there.items() if k != "timing_s"}
-            == {k: v for k, v in here.items() if k != "timing_s"})

@@ -3,6 +3,8 @@ and the trace from every coefficient back to raw files."""
 
 from __future__ import annotations
 
+import pytest
+
 import hashlib
 import warnings
 
@@ -14,6 +16,8 @@ from traceability import open_database
 from traceability.models import CurveFit, RawFile, RunResult, WpmExport
 from traceability.queries import latest_results
 from wpm_export import WheelPerformanceModule
+
+pytestmark = pytest.mark.slow  # the whole sample campaign (60 runs) processed once for both tests
 
 
 def test_load_interpolation_predicts_the_120_n_runs(processed_sample_db):

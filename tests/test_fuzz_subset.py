@@ -4,6 +4,8 @@ physically impossible value marked ok."""
 
 from __future__ import annotations
 
+import pytest
+
 from collections import Counter
 
 from bench.bench_reliability import fuzz
@@ -13,6 +15,7 @@ SEED = 1  # the bench itself runs seed 17
 INPUTS = 500
 
 
+@pytest.mark.slow  # 500 mutated runs, each read and processed
 def test_five_hundred_mutated_runs_fail_cleanly_or_give_sound_results():
     counts, faults = fuzz(INPUTS, SEED)
     total = sum(counts.values(), Counter())

@@ -8,6 +8,7 @@ import json
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from validation.gap_bench import MARS_GRAVITY_MPS2, Design, base_model, run_bench, smooth_wheel
 from virtual_testbed.rig import BB2_WHEEL
@@ -17,6 +18,7 @@ TINY = Design(loads_n=(80.0, 250.0), slips=(0.2, 0.6), multipass=(0, 1),
 SEED = 5
 
 
+@pytest.mark.slow  # 16 runs processed and diagnosed as two sources
 def test_smooth_wheel_runs_on_the_same_hidden_soil_and_is_diagnosed_with_the_lugged(tmp_path):
     run_bench(1, SEED, tmp_path, TINY, jobs=1, boot=5, truth_laws="held-out")
     label = json.loads((tmp_path / "labels" / "labels.json").read_text())["c000"]

@@ -62,8 +62,14 @@ def replicated(tmp_path_factory):
     return out / "campaign"
 
 
-def test_replicates_recognised_and_consistent_with_the_budget(replicated, tmp_path):
-    campaign = swtlab.process_campaign(replicated, soil_flow=False)
+@pytest.fixture(scope="module")
+def processed(replicated):
+    """The replicated campaign processed once (the two tests below read it, neither changes it)."""
+    return swtlab.process_campaign(replicated, soil_flow=False)
+
+
+def test_replicates_recognised_and_consistent_with_the_budget(replicated, processed, tmp_path):
+    campaign = processed
     spread = campaign.replicates
     assert set(map(tuple, spread["run_ids"])) == {tuple(f"a{i}" for i in range(6)),
                                                   tuple(f"b{i}" for i in range(6))}
@@ -92,11 +98,11 @@ def test_replicates_recognised_and_consistent_with_the_budget(replicated, tmp_pa
         assert (stored[f"{q}_dof"].dropna() > 5).all()   # pooled: many degrees of freedom
 
 
-def test_the_report_shows_the_replicate_spread_or_says_there_is_none(replicated):
+def test_the_report_shows_the_replicate_spread_or_says_there_is_none(processed):
     from campaign_report.data import from_results
     from campaign_report.replicates import replicates_section
 
-    campaign = swtlab.process_campaign(replicated, soil_flow=False)
+    campaign = processed
     results = [r.result for r in campaign.runs]
     section = replicates_section(from_results("virtual", results), None)
     table = section.blocks[1]

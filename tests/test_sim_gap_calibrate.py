@@ -11,7 +11,7 @@ import pytest
 
 import terramechanics as tm
 from sim_gap.calibrate import calibrate_soil, predict_with_se
-from sim_gap.holdout import holdout_dp, holdout_summary
+from validation.holdout import holdout_dp, holdout_summary
 from sim_gap.measured import from_cmu_smooth_runs
 from sim_gap.priors import published_soils, soil_prior
 from swtlab.domain import G0_MPS2

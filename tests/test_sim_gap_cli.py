@@ -1,5 +1,5 @@
-"""`swtlab gap` end to end on a tiny processed virtual campaign; `swtlab gap-bench` blind and
-scored through its labels file."""
+"""`swtlab gap` end to end on a tiny processed virtual campaign; the gap bench's scoring of a
+failed campaign and its option checks (the bench end to end: tests/test_gap_bench.py)."""
 
 from __future__ import annotations
 
@@ -13,13 +13,14 @@ import virtual_testbed as vt
 from swtlab_cli.cmd_gap import parse_laws
 from validation.gap_bench import (FAST_DESIGN, ModeFiles, base_model, conditions,
                                    diagnose_campaign, diagnosis_laws, format_score,
-                                   laws_option, make_campaigns, run_bench, score, truth_law)
+                                   laws_option, make_campaigns, score)
 from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import GapReport
 
-REQUIRED = {"verdict", "probability", "hypotheses", "effect_sets", "held_out_rmse_before", "held_out_rmse_after",
-            "shrink_pct", "regions", "reason", "separating_test", "untestable_effects"}
+REQUIRED = {"verdict", "probability", "hypotheses", "effect_sets", "held_out_rmse_before",
+            "held_out_rmse_after", "shrink_pct", "regions", "reason", "separating_test",
+            "untestable_effects"}
 
 
 def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
@@ -71,33 +72,6 @@ def test_gap_cli_bad_input(tmp_path, capsys):
         "grousers": ("ding2011", "bekker1956"), "slip_sinkage": ("lyasko2010",)}
 
 
-def test_gap_bench_is_blind_and_scored_from_labels(tmp_path):
-    """Held-out truth laws: one law per family left (so as fast as one law per effect)."""
-    result = run_bench(3, seed=4, workdir=tmp_path, design=FAST_DESIGN, jobs=2, boot=10,
-                       truth_laws="held-out")
-    labels = json.loads((tmp_path / "labels" / "labels.json").read_text())
-    assert sorted(labels) == ["c000", "c001", "c002"]
-    for i, name in enumerate(labels):  # the diagnosis saw no truth: it lives outside
-        assert not (tmp_path / name / "truth").exists()
-        assert (tmp_path / "labels" / name / "truth").is_dir()
-        report = json.loads((tmp_path / name / "gap-held-out.json").read_text())
-        allowed = report["settings"]["laws"]  # every family lost the truth's law
-        assert sorted(allowed) == sorted(tm.LAWS)
-        for effect, options in allowed.items():
-            assert sorted(options + [law for law in tm.LAWS[effect]
-                                    if tm.published_law(effect, law) == truth_law(i, effect)]
-                          ) == sorted(tm.LAWS[effect])
-        for effect, law in labels[name]["laws"].items():
-            assert law == truth_law(i, effect) and law not in allowed[effect]
-            assert labels[name]["truth_laws"] == "held-out"
-    assert result["n"] == 3 and sum(v["n"] for v in result["by_class"].values()) == 3
-    assert result == {**score(tmp_path / "labels" / "labels.json", tmp_path, "held-out"),
-                      "truth_laws": "held-out", "timing_s": result["timing_s"]}
-    rows = {r["campaign"]: r for r in result["campaigns"]}
-    assert [rows[n]["hidden"] for n in sorted(rows)] == [labels[n]["effects"]
-                                                         for n in sorted(labels)]
-
-
 def test_a_campaign_whose_chain_fails_is_scored_as_failed_and_the_bench_goes_on(tmp_path):
     """c001's database is missing (as when every run of a source was flagged, seed 30 c013):
     its `swtlab gap` exits with a one-line error, which the bench keeps, removing the
@@ -138,3 +112,10 @@ def test_gap_bench_modes_are_checked(tmp_path):
     assert laws_option(None) == ""
     assert laws_option({"grousers": ("bekker1956",), "slip_sinkage": ("ding2011", "x")}) == (
         "grousers=bekker1956,slip_sinkage=ding2011,slip_sinkage=x")
+
+
+def test_gap_bench_command_finds_the_bench_in_the_checkout(capsys):
+    """The bench's generators are not installed with swtlab: the command imports them from
+    the repository it runs from (and checks its options after that)."""
+    assert main(["gap-bench", "--n", "0"]) == 2
+    assert "swtlab gap-bench: --n must be >= 1" in capsys.readouterr().out

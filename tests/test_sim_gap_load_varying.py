@@ -7,7 +7,6 @@ diagnosis."""
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from bench.bench_law_mimic import UNEXPLAINED_RMS_SIGMA, held_out_rms, truth_model, write_points

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 
 import numpy as np
@@ -15,10 +16,22 @@ from virtual_testbed.flow_render import (FlowScene, default_radial_decay_per_m,
                                          write_flow_render)
 
 
-@pytest.fixture(scope="module", params=[5, 9])
-def smooth_wheel(request):
-    scene = FlowScene(seed=request.param)
+@functools.lru_cache(maxsize=None)
+def _render(seed: int):
+    scene = FlowScene(seed=seed)
     return scene, render_flow(scene, 10)
+
+
+@pytest.fixture(scope="module", params=[5, 9])
+def smooth_wheels(request):
+    """Two renders for the accuracy check."""
+    return _render(request.param)
+
+
+@pytest.fixture(scope="module")
+def smooth_wheel():
+    """One of them for the checks of the outputs' form (the same path on either render)."""
+    return _render(5)
 
 
 def _contact(result):
@@ -26,8 +39,9 @@ def _contact(result):
     return (beta < -np.deg2rad(20)) & (beta > -np.deg2rad(160))
 
 
-def test_decay_rates_within_5_percent(smooth_wheel):
-    scene, r = smooth_wheel
+@pytest.mark.slow  # optical flow on ten rendered frames, two renders
+def test_decay_rates_within_5_percent(smooth_wheels):
+    scene, r = smooth_wheels
     res = analyse_frames(r.frames, r.t_s, scene.px_per_m)
     contact = _contact(res)
     theta = res.beta_rad + np.pi / 2
@@ -64,6 +78,7 @@ def test_alpha1_alpha2_from_given_strain(smooth_wheel):
                for row in data["per_beta"])
 
 
+@pytest.mark.slow  # optical flow on six supersampled frames per grouser model
 @pytest.mark.parametrize("model, seed", [("piecewise", 100), ("gear", 103)])
 def test_grouser_model_chosen(model, seed):
     scene = FlowScene(grouser_count=12, grouser_height_px=10, grouser_model=model,

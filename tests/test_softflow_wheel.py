@@ -41,6 +41,7 @@ def test_metadata_overrides(sinking):
     assert not mask[111, 151 + 80] and mask[111, 151 + 90]
 
 
+@pytest.mark.slow  # wheel detection on supersampled renders
 @pytest.mark.parametrize("noise_std", [0.0, 2.0])
 def test_painted_ring_is_not_the_rim(noise_std):
     """The rendered wheel carries a bright ring at 0.75 R. Noise-free, the ring's edges are

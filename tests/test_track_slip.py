@@ -33,6 +33,7 @@ def _random_render(i: int):
                         nuisance=random_nuisance(20_000 + i, (640, 480)))
 
 
+@pytest.mark.slow  # 50 track photos rendered and measured
 def test_accuracy_over_50_random_renders():
     errors_pp, refused = [], 0
     for i in range(RENDERS):

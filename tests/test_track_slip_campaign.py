@@ -16,6 +16,7 @@ from virtual_testbed.sensors import Rates
 RATES = Rates(40.0, 40.0, 20.0, 20.0, 10.0, 10.0)
 
 
+@pytest.mark.slow  # a five-run campaign with track photos generated, processed and reported
 def test_image_slip_beside_encoder_slip(tmp_path, capsys):
     slips = (0.05, 0.2, 0.4, 0.7)
     conditions = [RunCondition(f"P{i}", "speed_control", 180.0, 0, s, track_photos=2)

@@ -100,18 +100,12 @@ def test_slip_query_prints_every_quantity(capsys, wpm_csv):
 
 
 @pytest.mark.parametrize("argv, message", [
-<<<<<<< HEAD
-    (["--load", "120", "--dp", "25"], "2 curve sets match"),
-    (["--load", "400", "--dp", "25", "--multipass", "0"],
-     "load_n=400 N is outside the tested loads"),
-    (["--load", "120", "--dp", "25", "--soil", "clay"], "no curves for soil='clay'"),
-=======
     (["--load", "120", "--dp", "25"], "2 curve sets match in "),
     (["--load", "120", "--dp", "25"], "pick one: --soil bb2_sand --wheel bb2 --multipass 0; "
                                       "--soil bb2_sand --wheel bb2 --multipass 1"),
-    (["--load", "400", "--dp", "25", "--multipass", "0"], "load 400 N outside the tested loads"),
+    (["--load", "400", "--dp", "25", "--multipass", "0"],
+     "--load 400 N is outside the tested loads"),
     (["--load", "120", "--dp", "25", "--soil", "clay"], "no curves for --soil clay in "),
->>>>>>> ingest
 ])
 def test_bad_queries_exit_3_with_one_line(capsys, wpm_csv, argv, message):
     code, out, err = _run(capsys, wpm_csv, *argv)

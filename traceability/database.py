@@ -90,16 +90,16 @@ def _engine(url: URL, writer: bool) -> Engine:
     engine = create_engine(url, connect_args=connect_args)
     if backend == "sqlite":
         @event.listens_for(engine, "connect")
-        def _sqlite_connect(dbapi_connection, _record):  # noqa: ANN001 - DB-API types
+        def _sqlite_connect(dbapi_connection, _record):
             dbapi_connection.isolation_level = None  # transactions begin below, not in pysqlite
             dbapi_connection.execute("PRAGMA foreign_keys=ON")
 
         @event.listens_for(engine, "begin")
-        def _sqlite_begin(connection):  # noqa: ANN001
+        def _sqlite_begin(connection):
             connection.exec_driver_sql("BEGIN IMMEDIATE" if writer else "BEGIN")
     elif backend == "postgresql" and writer:
         @event.listens_for(engine, "begin")
-        def _pg_begin(connection):  # noqa: ANN001
+        def _pg_begin(connection):
             connection.exec_driver_sql(f"SELECT pg_advisory_xact_lock({WRITE_LOCK_KEY})")
     return engine
 

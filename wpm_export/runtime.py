@@ -35,7 +35,10 @@ for _status in _STATUS_0D.values():
 
 
 def _selection_text(soil, wheel, multipass) -> str:
-    return f"soil={soil!r}, wheel={wheel!r}, multipass={multipass!r}"
+    """A curve set as the keyword arguments that select it (those given; the command line
+    prints them as its flags)."""
+    given = {"soil": soil, "wheel": wheel, "multipass": multipass}
+    return ", ".join(f"{k}={v!r}" for k, v in given.items() if v is not None)
 
 
 class WheelPerformanceModule:

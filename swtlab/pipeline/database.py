@@ -81,7 +81,7 @@ def store_one(session_factory, done: ProcessedRun, parameters: dict, *,
             session, done, parameters, allow_run_id_reuse=allow_run_id_reuse))
     except (OperationalError, InterfaceError):
         raise  # the database itself (locked, gone): not this run's fault
-    except Exception as error:  # noqa: BLE001 - one run the database refuses, not the batch
+    except Exception as error:  # one run the database refuses, not the batch
         failure = Failure.of(done.path, "store", getattr(error, "orig", None) or error)
         done.failures.append(failure)
     run_id = None if done.run is None else done.run.run_id

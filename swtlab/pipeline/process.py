@@ -102,7 +102,7 @@ def _soil_flow(done: ProcessedRun, settings: ProcessSettings) -> None:
     except FlowRunError as error:
         done.failures.append(Failure(str(done.path), "soil_flow", error.problem, "FlowRunError"))
         return
-    except Exception as error:  # noqa: BLE001 - one run's camera must not stop the batch
+    except Exception as error:  # one run's camera must not stop the batch
         done.failures.append(Failure.of(done.path, "soil_flow", error))
         return
     if flow is not None:
@@ -130,14 +130,14 @@ def process_file(path: Path, settings: ProcessSettings,
             done.sha256, done.size_bytes = content or content_sha256(path)
             done.run = ingest.read_run(path, channel_map=settings.channel_map)
             done.streams = stream_report(done.run)
-        except Exception as error:  # noqa: BLE001 - one bad file must not stop the batch
+        except Exception as error:  # one bad file must not stop the batch
             done.run = None
             done.failures.append(Failure.of(path, "ingest", error))
             return done
         try:
             done.result = process_run(done.run, settings.stable, settings.rig,
                                       run_image_slip(done.run), settings.budget)
-        except Exception as error:  # noqa: BLE001
+        except Exception as error:
             done.failures.append(Failure.of(path, "results", error))
             return done
         _soil_flow(done, settings)
