@@ -67,7 +67,8 @@ def draw_wheel(rng: np.random.Generator, name: str, lugged: bool, flexible: bool
 def draw_plan(rng: np.random.Generator, name: str, effects: set[str]) -> Plan:
     """The lab's plan for a campaign whose truth holds ``effects``."""
     low = round(float(rng.uniform(40.0, 80.0)))
-    loads = (low, round(low * float(rng.uniform(1.8, 2.2))), round(low * float(rng.uniform(3.0, 3.6))))
+    loads = (low, round(low * float(rng.uniform(1.8, 2.2))),
+             round(low * float(rng.uniform(3.0, 3.6))))
     lugged = "grousers" in effects
     wheel = draw_wheel(rng, f"{name}_wheel", lugged, "wheel_flexibility" in effects, loads[1])
     twin = None
@@ -85,7 +86,7 @@ def draw_plan(rng: np.random.Generator, name: str, effects: set[str]) -> Plan:
     velocities = (REFERENCE_VELOCITY_MPS, FAST_VELOCITY_MPS) if fast else (REFERENCE_VELOCITY_MPS,)
 
     runs: list[tuple[str, dict]] = []
-    for li, load in enumerate(loads):
+    for load in loads:
         fast_slips = set(rng.choice(len(slips), size=len(slips) // 2, replace=False).tolist())
         for si, slip in enumerate(slips):
             v = FAST_VELOCITY_MPS if fast and si in fast_slips else REFERENCE_VELOCITY_MPS

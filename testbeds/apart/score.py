@@ -181,7 +181,8 @@ def markdown(result: dict) -> str:
         lead = "-" if r["p_leading"] is None else f"{r['leading']} ({r['p_leading']:.2f})"
         lines.append(f"| {r['campaign']} | {_label(r)} | {r['runs']} ({r['sources']}) | "
                      f"{verdict} | {lead} | {r['outcome']} |")
-    lines += ["", "| class | n | right | inconclusive | wrong | failed |", "|---|---|---|---|---|---|"]
+    lines += ["", "| class | n | right | inconclusive | wrong | failed |",
+              "|---|---|---|---|---|---|"]
     for cls, v in result["by_class"].items():
         if v["n"]:
             lines.append(f"| {cls} | {v['n']} | {v['right']} | {v['inconclusive']} | "

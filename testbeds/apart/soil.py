@@ -97,12 +97,12 @@ class ReeceSoil:
 def from_published(soil: PublishedSoil, width_m: float) -> ReeceSoil:
     """The Reece soil with the published set's pressure at width ``width_m`` and g0; Wong's
     ``K_w`` at twice the published Janosi K (Janosi's curve reaches 86 % of its strength at
-    2 K), no hump (``K_r`` = 1)."""
+    2 K), residual ratio ``K_r`` = 1 (the campaign draws its own)."""
     scale = width_m ** (soil.n - 1)
     kc_prime = soil.kc * scale / soil.cohesion_pa if soil.cohesion_pa > 0 else 0.0
-    return ReeceSoil(kc_prime=kc_prime, kphi_prime=soil.kphi * scale / (soil.density_kg_m3 * G0_MPS2),
-                     n=soil.n, cohesion_pa=soil.cohesion_pa,
-                     friction_angle_deg=soil.friction_angle_deg,
+    kphi_prime = soil.kphi * scale / (soil.density_kg_m3 * G0_MPS2)
+    return ReeceSoil(kc_prime=kc_prime, kphi_prime=kphi_prime, n=soil.n,
+                     cohesion_pa=soil.cohesion_pa, friction_angle_deg=soil.friction_angle_deg,
                      density_kg_m3=soil.density_kg_m3, shear_peak_m=2 * soil.shear_modulus_m)
 
 
