@@ -84,7 +84,7 @@ def test_flexible_wheel_forces_match_hand_quadrature():
     ratio = 1 - slip
     j_front = r * ((theta1 - theta_f) - ratio * (math.sin(theta1) - math.sin(theta_f)))
     tau_arc = float(shear_stress_pa(SOIL, sigma_f, j_front))
-    tau_flat = float(shear_stress_pa(SOIL, sigma_f, j_front + (1 / ratio - 1) * half))
+    tau_flat = float(shear_stress_pa(SOIL, sigma_f, (1 / ratio - 1) * half))
     theta2 = -theta_f - 0.1 * (theta1 - theta_f)
 
     def front(f):

@@ -26,9 +26,11 @@ Forces per unit of the stress profile ``f`` (closed-form integrals of linear fun
 
 A flexible wheel (deflection ``delta``) has a flat chord of half-length
 ``l = sqrt(2 r delta - delta^2)`` at the sinkage ``z``: uniform ``sigma_f = p(z)`` on it, its
-shear at the mean displacement over the chord (the arc's at the chord's front plus the slip
-displacement ``(r omega / v - 1) l``), lever arm ``r - delta``; linear arcs in front (entry
-``theta1 = acos(1 - (z + delta)/r)``) and behind (rebound ``0.1 (theta1 - theta_f)``).
+shear at the mean slip displacement over the chord, ``(r omega / v - 1) l`` (as on the flat
+contact of a tyre, Wong 2008 §2.4: ``j = i x`` from the front of the flat, the tread moving
+with the ground at zero slip), lever arm ``r - delta``; linear arcs in front (entry
+``theta1 = acos(1 - (z + delta)/r)``, the rim's kinematics) and behind (rebound
+``0.1 (theta1 - theta_f)``).
 The vertical equilibrium ``W = load`` is solved for the sinkage by Brent's method.
 """
 
@@ -114,8 +116,8 @@ def forces_at(contact: Contact, theta1: float, slip: float) -> dict[str, float]:
     sigma_f = float(pressure_pa(soil, z, b, g))
     j_front = displacement_m(r, theta1, theta_f, ratio)
     tau_arc = contact.shear_gain * float(shear_stress_pa(soil, sigma_f, j_front))
-    tau_flat = contact.shear_gain * float(shear_stress_pa(
-        soil, sigma_f, j_front + (1 / ratio - 1) * half))
+    tau_flat = contact.shear_gain * float(shear_stress_pa(soil, sigma_f,
+                                                          (1 / ratio - 1) * half))
     theta2 = -theta_f - REAR_RATIO * (theta1 - theta_f)
     front = linear_integrals(theta_f, theta1, 1.0, 0.0)
     rear = linear_integrals(theta2, -theta_f, 0.0, 1.0)
