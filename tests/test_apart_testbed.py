@@ -269,3 +269,42 @@ def test_written_campaign_reads_through_inspect_and_keeps_its_truth_apart(tmp_pa
         assert seen["run"]["slip_setpoint"] == t["slip_setpoint"]
         assert seen["wheel"]["radius_m"] == wheel["radius_m"]
         assert seen["wheel"]["stiffness_n_per_mm"] == wheel["stiffness_n_per_mm"]
+
+
+def _truth(name, effects, outside=()):
+    cls = "outside" if outside else ("none", "single", "pair")[len(effects)]
+    return {"campaign": name, "class": cls, "effects": list(effects), "outside": list(outside),
+            "runs": [{}] * 22, "plan": {"twin": None}}
+
+
+@pytest.mark.parametrize("effects, outside, report, outcome, p_true", [
+    (["grousers"], [], {"verdict": ["grousers"]}, "right", None),
+    (["grousers", "multipass"], [], {"verdict": ["multipass", "grousers"]}, "right", None),
+    ([], [], {"verdict": []}, "right", None),
+    (["grousers"], [], {"verdict": ["slip_sinkage"]}, "wrong", None),
+    (["grousers"], [], {"verdict": "inconclusive",
+                        "probabilities": {"grousers(ding2011)": 0.5, "grousers(bekker1956)": 0.2,
+                                          "slip_sinkage(lyasko2010)": 0.3}}, "inconclusive", 0.7),
+    ([], ["rate_effect"], {"verdict": "inconclusive"}, "right", None),
+    ([], ["rate_effect"], {"verdict": "outside the candidates"}, "right", None),
+    (["bulldozing"], ["rig_artefact"], {"verdict": ["bulldozing"]}, "wrong", None),
+    ([], [], {"verdict": "inconclusive", "probabilities": [
+        {"label": "soil_only", "probability": 0.6}, {"label": "outside", "probability": 0.4}]},
+     "inconclusive", 0.6),
+])
+def test_scorer_reads_verdicts_and_probabilities(tmp_path, effects, outside, report, outcome,
+                                                 p_true):
+    from testbeds.apart.score import score_campaign
+
+    (tmp_path / "gap.json").write_text(json.dumps(report))
+    row = score_campaign(tmp_path, _truth("c000", effects, outside))
+    assert row["outcome"] == outcome
+    assert row["p_true"] == (pytest.approx(p_true) if p_true is not None else None)
+
+
+def test_scorer_counts_a_failed_step(tmp_path):
+    from testbeds.apart.score import score_campaign
+
+    (tmp_path / "failure.txt").write_text("gap: no usable run\n")
+    row = score_campaign(tmp_path, _truth("c000", ["grousers"]))
+    assert row["outcome"] == "failed" and row["failed"] == "gap: no usable run"

@@ -134,9 +134,7 @@ def score_campaign(folder: Path, truth: dict) -> dict:
     verdict = report.get("verdict")
     row["verdict"] = verdict if isinstance(verdict, str) else list(verdict or [])
     row["chosen"] = report.get("chosen")
-    called = effects_of(verdict) if not isinstance(verdict, str) or verdict.strip() else None
-    if isinstance(verdict, list):
-        called = effects_of(verdict) if verdict else ()
+    called = () if verdict == [] else effects_of(verdict)
     truth_set = tuple(e for e in SIX if e in truth["effects"])
     if truth["outside"]:
         row["outcome"] = "wrong" if called is not None else "right"
