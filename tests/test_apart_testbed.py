@@ -308,3 +308,20 @@ def test_scorer_counts_a_failed_step(tmp_path):
     (tmp_path / "failure.txt").write_text("gap: no usable run\n")
     row = score_campaign(tmp_path, _truth("c000", ["grousers"]))
     assert row["outcome"] == "failed" and row["failed"] == "gap: no usable run"
+
+
+@pytest.mark.parametrize("slip", [-0.2, -0.5])
+def test_braked_branch_brackets_the_cmu_smooth_wheel(ingest_cmu_root, slip):
+    """INDEPENDENT, real data: the CMU smooth wheel (r 58 mm, b 50 mm, about 20 N; straight
+    runs of smooth_runs.csv) brakes at DP/W about -0.35 at s = -0.2 and -0.85 at -0.5. The
+    solver, untuned, on that wheel over the four published soils brackets both."""
+    import pandas as pd
+
+    runs = pd.read_csv(ingest_cmu_root / "smooth_runs.csv").dropna(subset=["run_file"])
+    runs = runs[(runs.slip_angle_deg == 0) & ((runs.slip - slip).abs() < 0.01)]
+    assert len(runs) >= 3
+    measured = float((runs.tractive_force_n / runs.wheel_load_n).mean())
+    load = float(runs.wheel_load_n.mean())
+    modelled = [solve(Contact(from_published(p, 0.05), 0.058, 0.05, G0), load, slip)["dp_n"]
+                / load for p in PUBLISHED]
+    assert min(modelled) < measured < max(modelled)
