@@ -14,9 +14,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from testbeds.apart.soil import G0_MPS2
 from testbeds.apart.truth import REFERENCE_VELOCITY_MPS, RunSpec, WheelSpec
 
-G0_MPS2 = 9.80665
 BASE_SLIPS = (-0.2, 0.0, 0.1, 0.25, 0.45, 0.7)
 #: the slips (indices of BASE_SLIPS) run at a second multipass or gravity level
 LEVEL_SLIPS = (1, 3, 4, 5)

@@ -31,8 +31,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-SIX = ("grousers", "slip_sinkage", "reduced_gravity", "wheel_flexibility", "multipass",
-       "bulldozing")
+from testbeds.apart.effects import SIX
+
 CLASSES = ("none", "single", "pair", "outside")
 
 

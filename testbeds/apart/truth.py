@@ -10,10 +10,11 @@ effect (drawbar pull). A rig artefact changes only what a channel reads.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from testbeds.apart import effects as fx
-from testbeds.apart.soil import ReeceSoil
+from testbeds.apart.soil import G0_MPS2, ReeceSoil
 from testbeds.apart.solver import Contact, solve
 
 REFERENCE_VELOCITY_MPS = 0.01
@@ -41,7 +42,7 @@ class RunSpec:
     load_n: float
     slip: float
     multipass: int = 0
-    gravity_mps2: float = 9.80665
+    gravity_mps2: float = G0_MPS2
     velocity_mps: float = REFERENCE_VELOCITY_MPS
     order: float = 0.0
 
@@ -61,7 +62,7 @@ class Truth:
         kphi, phi = scatter["kphi_factor"], scatter["friction_deg"]
         drift = self.effects.get("soil_drift")
         if drift:
-            kphi *= float(2.718281828459045 ** (drift["kphi_log_change"] * (run.order - 0.5)))
+            kphi *= math.exp(drift["kphi_log_change"] * (run.order - 0.5))
             phi += drift["friction_change_deg"] * (run.order - 0.5)
         s = self.soil
         return s.with_(kc_prime=s.kc_prime * kphi, kphi_prime=s.kphi_prime * kphi,
