@@ -34,12 +34,12 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     jobs = [(args.out, args.seed, i) for i in range(args.start, args.start + args.n)]
     if args.jobs == 1:
-        lines = map(_one, jobs)
+        for line in map(_one, jobs):
+            print(line, flush=True)
     else:
-        pool = ProcessPoolExecutor(args.jobs)
-        lines = pool.map(_one, jobs)
-    for line in lines:
-        print(line, flush=True)
+        with ProcessPoolExecutor(args.jobs) as pool:
+            for line in pool.map(_one, jobs):
+                print(line, flush=True)
     print(f"{args.n} campaigns in {time.perf_counter() - start:.0f} s under {args.out} "
           f"(truths in {args.out / 'truth'}: keep them from the diagnosis)")
     return 0
