@@ -7,8 +7,10 @@ cNNN/sim.toml --json cNNN/gap.json``, each a separate process that is given the 
 folder only; the truth (``DIR/truth/``) is read by this scorer alone, after the diagnosis. A
 step that fails writes its one-line error to ``cNNN/failure.txt`` and the bench goes on.
 
-The report is read defensively: ``verdict`` (a list of effects, ``[]``, or a string such as
-``inconclusive``) and, where the diagnosis gives them, ``probabilities`` (a mapping or a list
+``chosen`` (the leading candidate, named whatever the verdict) is compared with the truth's
+effects of the six: whether the ranking puts the truth first. The report is read
+defensively: ``verdict`` (a list of effects, ``[]``, or a string such as ``inconclusive``)
+and, where the diagnosis gives them, ``probabilities`` (a mapping or a list
 of hypotheses with probabilities): the probability of the leading hypothesis and of the true
 one are tabulated when they can be read.
 
@@ -142,6 +144,8 @@ def score_campaign(folder: Path, truth: dict) -> dict:
         row["outcome"] = "inconclusive"
     else:
         row["outcome"] = "right" if called == truth_set else "wrong"
+    chosen = effects_of(row["chosen"]) if row["chosen"] else None
+    row["chosen_is_truth"] = chosen is not None and chosen == truth_set
     probs = probabilities(report)
     if probs:
         leading = max(probs, key=probs.get)
@@ -161,6 +165,7 @@ def score(out: Path) -> dict:
         sub = [r for r in rows if r["class"] == cls]
         by_class[cls] = {"n": len(sub)} | {k: sum(r["outcome"] == k for r in sub)
                                             for k in ("right", "inconclusive", "wrong", "failed")}
+        by_class[cls]["chosen_is_truth"] = sum(bool(r.get("chosen_is_truth")) for r in sub)
     return {"n": len(rows), "by_class": by_class, "campaigns": rows}
 
 
@@ -171,20 +176,20 @@ def _label(r: dict) -> str:
 
 def markdown(result: dict) -> str:
     """The per-campaign table and the counts per class, in Markdown."""
-    lines = ["| campaign | truth | runs (sources) | verdict | leading (p) | outcome |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| campaign | truth | runs (sources) | verdict | chosen | leading (p) | outcome |",
+             "|---|---|---|---|---|---|---|"]
     for r in result["campaigns"]:
         verdict = (r["failed"] and f"failed: {r['failed'][:60]}") or (
             r["verdict"] if isinstance(r["verdict"], str) else "+".join(r["verdict"]) or "none")
         lead = "-" if r["p_leading"] is None else f"{r['leading']} ({r['p_leading']:.2f})"
         lines.append(f"| {r['campaign']} | {_label(r)} | {r['runs']} ({r['sources']}) | "
-                     f"{verdict} | {lead} | {r['outcome']} |")
-    lines += ["", "| class | n | right | inconclusive | wrong | failed |",
-              "|---|---|---|---|---|---|"]
+                     f"{verdict} | {r['chosen'] or '-'} | {lead} | {r['outcome']} |")
+    lines += ["", "| class | n | right | inconclusive | wrong | failed | chosen = truth's six |",
+              "|---|---|---|---|---|---|---|"]
     for cls, v in result["by_class"].items():
         if v["n"]:
             lines.append(f"| {cls} | {v['n']} | {v['right']} | {v['inconclusive']} | "
-                         f"{v['wrong']} | {v['failed']} |")
+                         f"{v['wrong']} | {v['failed']} | {v['chosen_is_truth']} |")
     return "\n".join(lines)
 
 
