@@ -325,3 +325,18 @@ def test_braked_branch_brackets_the_cmu_smooth_wheel(ingest_cmu_root, slip):
     modelled = [solve(Contact(from_published(p, 0.05), 0.058, 0.05, G0), load, slip)["dp_n"]
                 / load for p in PUBLISHED]
     assert min(modelled) < measured < max(modelled)
+
+
+def test_a_lugged_wheel_runs_steady_for_four_grouser_periods():
+    from testbeds.apart.campaign import timeline
+    from testbeds.apart.design import draw_plan
+
+    for seed in range(20):
+        plan = draw_plan(np.random.default_rng(seed), "c000", {"grousers"})
+        tl = timeline(plan)
+        w = plan.wheel
+        slowest = min(r.velocity_mps * (1 + r.slip) if r.slip < 0 else
+                      r.velocity_mps / (1 - r.slip) for _, r in plan.runs)
+        period = 2 * math.pi * w.radius_m / (w.grouser_count * slowest)
+        steady = tl.decel_start_s - tl.motion_start_s - tl.settle_s
+        assert steady >= max(4 * period, 14.5) - 1e-9

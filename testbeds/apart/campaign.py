@@ -41,8 +41,12 @@ from validation.second_rig import (Rig, RunCondition, SensorModel, Timeline, Whe
                                    write_campaign)
 
 TRUTH_SCHEMA = "swtlab.testbeds.apart.truth/1"
-#: short runs: 3 s rest, transients settled in 14 s, >= 10 s steady
-TIMELINE = Timeline(duration_s=36.0, settle_s=14.0)
+#: short runs: 3 s rest, transients settled in 14 s, steady for STEADY_S, 1.5 s stop, 3 s rest
+SETTLE_S = 14.0
+STEADY_S = 14.5
+#: a lugged wheel runs steady for this many grouser periods at least (at its slowest run):
+#: the chain refuses a window under 2 periods and cuts its start (docs/stable-phase.md)
+STEADY_GROUSER_PERIODS = 4
 SIX_COUNT_PROBABILITY = (0.25, 0.45, 0.30)
 OUTSIDE_PROBABILITY = 0.25
 MAX_DRAWS = 50
@@ -127,6 +131,22 @@ def sim_toml(wheel: WheelSpec, soil: PublishedSoil) -> str:
         ""])
 
 
+def timeline(plan: Plan) -> Timeline:
+    """Run length of the campaign: :data:`STEADY_S` steady, longer where a lugged wheel's
+    slowest run needs :data:`STEADY_GROUSER_PERIODS` grouser periods."""
+    steady = STEADY_S
+    for _, run in plan.runs:
+        w = run.wheel
+        if w.grouser_count:
+            surface = run.velocity_mps / (1 - run.slip) if run.slip >= 0 else \
+                run.velocity_mps * (1 + run.slip)
+            period = 2 * math.pi * w.radius_m / (w.grouser_count * surface)
+            steady = max(steady, STEADY_GROUSER_PERIODS * period)
+    tl = Timeline(settle_s=SETTLE_S)
+    return Timeline(duration_s=math.ceil(tl.rest_before_s + SETTLE_S + steady + tl.decel_s
+                                         + tl.rest_after_s), settle_s=SETTLE_S)
+
+
 def _geometry(wheel: WheelSpec) -> WheelGeometry:
     return WheelGeometry(name=wheel.name, radius_m=wheel.radius_m, width_m=wheel.width_m,
                          grouser_count=wheel.grouser_count,
@@ -173,7 +193,7 @@ def write_campaign_folder(out: str | Path, seed: int, index: int) -> dict:
     if folder.exists():
         shutil.rmtree(folder)
     rng = np.random.default_rng([int(seed), int(index), 1])
-    rig = Rig(timeline=TIMELINE,
+    rig = Rig(timeline=timeline(plan),
               sensors=SensorModel(write_calibration_uncertainty=bool(rng.random() < 0.5)))
     campaign_of = {"main": name + ("_lugged" if plan.wheel.grouser_count else ""),
                    "smooth": f"{name}_smooth"}
