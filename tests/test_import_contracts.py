@@ -1,7 +1,8 @@
 """The package boundaries of docs/architecture (pyproject.toml [tool.importlinter]): no estimator
 imports the virtual testbed or the blind benches, no installed package imports the repository's
 test code, no stage imports the CLI or the report, the report does not import the CLI, the
-second rig imports neither the virtual testbed nor any estimator, the domain model
+second rig imports neither the virtual testbed nor any estimator, the apart testbed
+(testbeds.apart) imports neither the project's physics nor any estimator, the domain model
 (swtlab.domain) imports no stage and no stage imports the pipeline (swtlab.pipeline).
 import-linter follows indirect imports too. And what `pip install swtlab` installs: the
 stages, not the test code."""
@@ -19,7 +20,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
-TEST_CODE = ("virtual_testbed", "validation", "bench", "tests")
+TEST_CODE = ("virtual_testbed", "validation", "testbeds", "bench", "tests")
 
 
 def test_import_contracts_kept():

@@ -1,0 +1,238 @@
+"""Run the full chain on the apart testbed's campaigns and score the verdicts against the truth:
+``python -m testbeds.apart.score DIR [--jobs J] [--boot B] [--redo] [--json OUT] [--markdown]``.
+
+Per campaign ``DIR/cNNN``: ``swtlab process`` of ``campaign/`` (and ``smooth/campaign/``)
+into ``cNNN/main.sqlite`` (``smooth.sqlite``), then ``swtlab gap --measured ... --sim
+cNNN/sim.toml --json cNNN/gap.json``, each a separate process that is given the campaign's
+folder only; the truth (``DIR/truth/``) is read by this scorer alone, after the diagnosis. A
+step that fails writes its one-line error to ``cNNN/failure.txt`` and the bench goes on.
+
+``chosen`` (the leading candidate, named whatever the verdict) is compared with the truth's
+effects of the six: whether the ranking puts the truth first. The report is read
+defensively: ``verdict`` (a list of effects, ``[]``, or a string such as ``inconclusive``)
+and, where the diagnosis gives them, ``probabilities`` (a mapping or a list
+of hypotheses with probabilities): the probability of the leading hypothesis and of the true
+one are tabulated when they can be read.
+
+Outcomes: a campaign whose gap is within the six is ``right`` when the verdict names exactly
+its effects, ``inconclusive``, or ``wrong`` (a named set that is not the truth: confidently
+wrong); a campaign with an effect outside the six is ``right`` when the verdict is not a set of
+effects (inconclusive, or outside the candidates) and ``wrong`` when it names effects.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from testbeds.apart.effects import SIX
+
+CLASSES = ("none", "single", "pair", "outside")
+
+
+def _write(path: Path, text: str) -> None:
+    with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as f:
+        f.write(text)
+    os.chmod(f.name, 0o644)
+    os.replace(f.name, path)
+
+
+def diagnose(folder: Path, boot: int, redo: bool = False, regap: bool = False) -> float:
+    """``swtlab process`` then ``swtlab gap`` on one campaign folder; seconds taken.
+    ``regap``: diagnose again from the databases already processed (a new diagnosis on the
+    same processed runs)."""
+    start = time.perf_counter()
+    gap, failure = folder / "gap.json", folder / "failure.txt"
+    if gap.exists() and not (redo or regap):
+        return 0.0
+    failure.unlink(missing_ok=True)
+    cli = [sys.executable, "-m", "swtlab_cli.main"]
+    sources = [(folder / "campaign", folder / "main.sqlite"),
+               (folder / "smooth" / "campaign", folder / "smooth.sqlite")]
+    measured = []
+    step = "process"
+    try:
+        for runs, db in sources:
+            if not runs.is_dir():
+                continue
+            if not (regap and db.exists()):
+                subprocess.run(cli + ["process", str(runs), "--db", f"sqlite:///{db}",
+                                      "--quiet", "--jobs", "1"], check=True,
+                               capture_output=True)
+            measured += ["--measured", f"sqlite:///{db}"]
+        step = "gap"
+        subprocess.run(cli + ["gap", *measured, "--sim", str(folder / "sim.toml"), "--json",
+                              str(gap), "--boot", str(boot)], check=True, capture_output=True)
+    except subprocess.CalledProcessError as e:
+        gap.unlink(missing_ok=True)
+        lines = (e.stderr or b"").decode(errors="replace").strip().splitlines()
+        _write(failure, f"{step}: {lines[-1] if lines else 'no message'}\n")
+    return time.perf_counter() - start
+
+
+def effects_of(label) -> tuple[str, ...] | None:
+    """The effect set a hypothesis label or verdict names (vocabulary order), ``()`` for no
+    missing effect, None when it names no set (inconclusive, outside the candidates)."""
+    if isinstance(label, list | tuple):
+        names = [str(x) for x in label]
+    elif isinstance(label, str):
+        text = label.strip().lower()
+        if text in ("", "none", "[]", "soil_only", "soil only", "no_missing_effect"):
+            return ()
+        names = [re.sub(r"\(.*?\)", "", part).strip() for part in re.split(r"[+,]", text)]
+    else:
+        return None
+    if not names or any(n not in SIX for n in names):
+        return None
+    return tuple(e for e in SIX if e in names)
+
+
+def probabilities(report: dict) -> dict[tuple[str, ...] | str, float]:
+    """Hypothesis -> probability, summed per effect set, from whichever form the report
+    gives (``{label: p}``, ``[{label|hypothesis|effects, probability|p}]``); {} if none."""
+    raw = report.get("probabilities", report.get("effect_sets"))
+    items = []
+    if isinstance(raw, dict):
+        for key in ("hypotheses", "by_hypothesis", "sets", "by_set"):
+            if isinstance(raw.get(key), dict | list):
+                raw = raw[key]
+                break
+    if isinstance(raw, dict):
+        items = [(k, v) for k, v in raw.items() if isinstance(v, int | float)]
+    elif isinstance(raw, list):
+        for entry in raw:
+            if isinstance(entry, dict):
+                label = next((entry[k] for k in ("effects", "label", "hypothesis", "name")
+                              if k in entry), None)
+                p = next((entry[k] for k in ("probability", "p", "posterior") if k in entry),
+                         None)
+                if label is not None and isinstance(p, int | float):
+                    items.append((label, p))
+    out: dict = {}
+    for label, p in items:
+        key = effects_of(label)
+        key = key if key is not None else str(label)
+        out[key] = out.get(key, 0.0) + float(p)
+    return out
+
+
+def score_campaign(folder: Path, truth: dict) -> dict:
+    """One row: the truth, the verdict, the outcome and the probabilities read."""
+    row = {"campaign": truth["campaign"], "class": truth["class"],
+           "effects": truth["effects"], "outside": truth["outside"],
+           "runs": len(truth["runs"]),
+           "sources": 1 + (truth["plan"]["twin"] is not None),
+           "verdict": None, "chosen": None, "outcome": "failed", "failed": None,
+           "p_leading": None, "leading": None, "p_true": None}
+    failure, gap = folder / "failure.txt", folder / "gap.json"
+    if failure.exists() or not gap.exists():
+        row["failed"] = failure.read_text().strip() if failure.exists() else "no report"
+        return row
+    report = json.loads(gap.read_text())
+    verdict = report.get("verdict")
+    row["verdict"] = verdict if isinstance(verdict, str) else list(verdict or [])
+    row["chosen"] = report.get("chosen")
+    called = () if verdict == [] else effects_of(verdict)
+    truth_set = tuple(e for e in SIX if e in truth["effects"])
+    if truth["outside"]:
+        row["outcome"] = "wrong" if called is not None else "right"
+    elif verdict == "outside_candidates":  # a confident call, and not the truth
+        row["outcome"] = "wrong"
+    elif called is None:
+        row["outcome"] = "inconclusive"
+    else:
+        row["outcome"] = "right" if called == truth_set else "wrong"
+    chosen = effects_of(row["chosen"]) if row["chosen"] else None
+    row["chosen_is_truth"] = chosen is not None and chosen == truth_set
+    probs = probabilities(report)
+    if probs:
+        leading = max(probs, key=probs.get)
+        row["leading"] = "+".join(leading) or "none" if isinstance(leading, tuple) else leading
+        row["p_leading"] = probs[leading]
+        if not truth["outside"]:
+            row["p_true"] = probs.get(truth_set, 0.0)
+    return row
+
+
+def score(out: Path) -> dict:
+    """Rows of every campaign with a truth file under ``out`` and the counts per class."""
+    rows = [score_campaign(out / path.stem, json.loads(path.read_text()))
+            for path in sorted((out / "truth").glob("c*.json"))]
+    by_class = {}
+    for cls in CLASSES:
+        sub = [r for r in rows if r["class"] == cls]
+        by_class[cls] = {"n": len(sub)} | {k: sum(r["outcome"] == k for r in sub)
+                                            for k in ("right", "inconclusive", "wrong", "failed")}
+        by_class[cls]["chosen_is_truth"] = sum(bool(r.get("chosen_is_truth")) for r in sub)
+    return {"n": len(rows), "by_class": by_class, "campaigns": rows}
+
+
+def _label(r: dict) -> str:
+    six = "+".join(r["effects"]) or "none"
+    return six + (" + outside: " + "+".join(r["outside"]) if r["outside"] else "")
+
+
+def markdown(result: dict) -> str:
+    """The per-campaign table and the counts per class, in Markdown."""
+    lines = ["| campaign | truth | runs (sources) | verdict | chosen | leading (p) | outcome |",
+             "|---|---|---|---|---|---|---|"]
+    for r in result["campaigns"]:
+        verdict = (r["failed"] and f"failed: {r['failed'][:60]}") or (
+            r["verdict"] if isinstance(r["verdict"], str) else "+".join(r["verdict"]) or "none")
+        lead = "-" if r["p_leading"] is None else f"{r['leading']} ({r['p_leading']:.2f})"
+        lines.append(f"| {r['campaign']} | {_label(r)} | {r['runs']} ({r['sources']}) | "
+                     f"{verdict} | {r['chosen'] or '-'} | {lead} | {r['outcome']} |")
+    lines += ["", "| class | n | right | inconclusive | wrong | failed | chosen = truth's six |",
+              "|---|---|---|---|---|---|---|"]
+    for cls, v in result["by_class"].items():
+        if v["n"]:
+            lines.append(f"| {cls} | {v['n']} | {v['right']} | {v['inconclusive']} | "
+                         f"{v['wrong']} | {v['failed']} | {v['chosen_is_truth']} |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m testbeds.apart.score",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("out", type=Path, help="folder written by testbeds.apart.campaigns")
+    parser.add_argument("--jobs", type=int, default=1, help="campaigns diagnosed at a time")
+    parser.add_argument("--boot", type=int, default=50, help="swtlab gap --boot")
+    parser.add_argument("--redo", action="store_true", help="diagnose again where a report is")
+    parser.add_argument("--regap", action="store_true",
+                        help="run swtlab gap again on the databases already processed")
+    parser.add_argument("--json", type=Path, help="write the scores here")
+    parser.add_argument("--markdown", action="store_true", help="print Markdown tables")
+    args = parser.parse_args(argv)
+    folders = [args.out / p.stem for p in sorted((args.out / "truth").glob("c*.json"))]
+    if not folders:
+        parser.error(f"{args.out}: no campaign (truth/cNNN.json) found")
+    start = time.perf_counter()
+    with ThreadPoolExecutor(max(args.jobs, 1)) as pool:
+        list(pool.map(lambda f: diagnose(f, args.boot, args.redo, args.regap), folders))
+    result = score(args.out)
+    result["seconds"] = time.perf_counter() - start
+    if args.json:
+        _write(args.json, json.dumps(result, indent=1) + "\n")
+    if args.markdown:
+        print(markdown(result))
+    else:
+        for r in result["campaigns"]:
+            print(f"{r['campaign']}: truth {_label(r)}; verdict {r['verdict'] or r['failed']}"
+                  f" -> {r['outcome']}")
+        for cls, v in result["by_class"].items():
+            if v["n"]:
+                print(f"{cls}: {v}")
+    print(f"{result['n']} campaigns, {result['seconds']:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
