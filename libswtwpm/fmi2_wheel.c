@@ -71,8 +71,8 @@ static void say(wheel_fmu *w, fmi2Status status, const char *format, ...)
                         status == fmi2OK ? "logAll" : "logStatusError", "%s", text);
 }
 
-/* the outputs at the current inputs (the half-widths only when asked for: they cost a
- * covariance per load): fmi2OK, fmi2Warning or fmi2Error (message logged) */
+/* the outputs at the current inputs (the half-widths only when asked for): fmi2OK,
+ * fmi2Warning or fmi2Error (message logged) */
 static fmi2Status update(wheel_fmu *w, int bands)
 {
     char msg[1024] = "", warning[1024] = "";

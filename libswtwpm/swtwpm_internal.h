@@ -36,6 +36,8 @@ typedef struct {
     double *at_tested; /* L x p */
     double *pieces;    /* 4 x (L - 1) x p: parameters cubic in (load - loads[k]) */
     double delta;      /* forward-difference step of the covariance propagation */
+    double *cov_ends;   /* L x p x p: each tested curve's covariance mapped to parameters */
+    double *cov_inside; /* (L - 1) x 7 x p x p: covariance, coefficients of t^0 ... t^6 */
 } wpm_quantity;
 
 typedef struct {

@@ -10,7 +10,9 @@
  *   tested loads: linear from the two nearest, only when asked;
  * - the covariance at a load: the tested curves' propagated through the interpolation (its
  *   sensitivity by the same forward difference as Python), plus with 3+ loads the
- *   PCHIP-minus-linear interpolation error v v^T / 3; scatter_sd and k95 linear in load;
+ *   PCHIP-minus-linear interpolation error v v^T / 3, precomputed as a polynomial of load
+ *   (sextic in t per interval, LoadPolynomial.covariance_pieces); scatter_sd and k95 linear
+ *   in load;
  * - the inverse (wpm_export/kernel.py, the same operations): each side of zero slip cut
  *   at the curve's turning points at the load (the real roots of its derivative in the
  *   range, isolated by those of the next derivative, recursively down to a quadratic) into
@@ -100,50 +102,6 @@ static void pchip_piece(const double *x, const double *y, int L, int i, double c
     c[1] = (slope - d0) / dx - t;
     c[2] = d0;
     c[3] = y[i];
-}
-
-/* the PPoly interval of w inside [x[0], x[L-1]] */
-static int pchip_interval(const double *x, int L, double w)
-{
-    int i = 0;
-    if (w >= x[L - 1])
-        return L - 2;
-    while (i < L - 2 && w >= x[i + 1])
-        ++i;
-    return i;
-}
-
-static double pchip_at(const double *x, const double *y, int L, double w)
-{
-    double c[4], s, z, out;
-    int i = pchip_interval(x, L, w);
-    pchip_piece(x, y, L, i, c);
-    s = w - x[i];
-    out = 0.0 + c[3];
-    z = s;
-    out = out + c[2] * z;
-    z *= s;
-    out = out + c[1] * z;
-    z *= s;
-    out = out + c[0] * z;
-    return out;
-}
-
-/* _across_load of one slip's values y over the tested loads x, at w */
-static double across_load(const double *x, const double *y, int L, double w, int pchip,
-                          int outside)
-{
-    int hi;
-    double t;
-    if (L == 1)
-        return y[0];
-    if (pchip && !outside)
-        return pchip_at(x, y, L, w);
-    for (hi = 0; hi < L && x[hi] < w; ++hi) /* searchsorted, side left */
-        ;
-    hi = hi < 1 ? 1 : hi > L - 1 ? L - 1 : hi;
-    t = (w - x[hi - 1]) / (x[hi] - x[hi - 1]);
-    return (1.0 - t) * y[hi - 1] + t * y[hi];
 }
 
 /* ---- least squares: pseudo-inverse by one-sided Jacobi SVD ---- */
@@ -274,6 +232,146 @@ static int compare_loads(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* the four coefficients (of (w - x[i])^3 ... ^0) of interval i across load: PCHIP, or
+ * linear (fitting.load_interp._linear_pieces) */
+static void piece(const double *x, const double *y, int L, int i, int pchip, double c[4])
+{
+    if (pchip) {
+        pchip_piece(x, y, L, i, c);
+        return;
+    }
+    c[0] = c[1] = 0.0;
+    c[2] = (y[i + 1] - y[i]) / (x[i + 1] - x[i]);
+    c[3] = y[i];
+}
+
+/* out (p x p) += A^T C B, A and B pk x p (row-major), C the pk x pk covariance */
+static void add_sandwich(const double *a, const double covariance[P_MAX][P_MAX],
+                         const double *b, int pk, int p, double scale, double *out)
+{
+    double cb[P_MAX * P_MAX];
+    int i, j, l;
+    for (i = 0; i < pk; ++i)
+        for (j = 0; j < p; ++j) {
+            double sum = 0.0;
+            for (l = 0; l < pk; ++l)
+                sum += covariance[i][l] * b[l * p + j];
+            cb[i * p + j] = sum;
+        }
+    for (i = 0; i < p; ++i)
+        for (j = 0; j < p; ++j) {
+            double sum = 0.0;
+            for (l = 0; l < pk; ++l)
+                sum += a[l * p + i] * cb[l * p + j];
+            out[i * p + j] += scale * sum;
+        }
+}
+
+/* The covariance of the parameters as a polynomial of load
+ * (fitting.load_interp.LoadPolynomial.covariance_pieces): ends (L x p x p), each tested
+ * curve's covariance mapped to the parameters; inside ((L - 1) x 7 x p x p), the
+ * coefficients of t^r between tested loads k and k + 1 (t = (load - loads[k]) / width):
+ * the propagated tested covariances (forward-difference sensitivities of the across-load
+ * pieces, cubic in t, their products sextic) plus, with 3+ loads, the interpolation error
+ * v v^T / 3 (v: the parameters of PCHIP less linear). */
+static int build_covariance(wpm_quantity *q)
+{
+    int L = q->n_loads, P = L - 1, p = q->p, k, kk, g, i, j, jj, b, m;
+    size_t pp = (size_t)p * p;
+    double *y = malloc((size_t)L * sizeof *y), *sensitivity = NULL, *a = NULL;
+    q->cov_ends = calloc((size_t)L * pp, sizeof *q->cov_ends);
+    q->cov_inside = calloc((size_t)(P > 0 ? P : 1) * 7 * pp, sizeof *q->cov_inside);
+    if (P > 0) {
+        sensitivity = malloc((size_t)4 * P * GRID_POINTS * sizeof *sensitivity);
+        a = malloc((size_t)4 * P_MAX * p * sizeof *a);
+    }
+    if (!y || !q->cov_ends || !q->cov_inside || (P > 0 && (!sensitivity || !a))) {
+        free(y), free(sensitivity), free(a);
+        return SWTWPM_E_MEMORY;
+    }
+    for (k = 0; k < L; ++k) {
+        const wpm_row *row = q->tested[k];
+        int pk = row->degree + 3;
+        double mapped[P_MAX * P_MAX];
+        memset(mapped, 0, sizeof mapped);
+        for (g = 0; g < GRID_POINTS; ++g) { /* parameter_gradient(grid).T @ to_theta */
+            double s = q->grid[g], gradient[P_MAX], below = s < 0;
+            for (i = 0; i <= row->degree; ++i)
+                gradient[i] = pow(s, i);
+            gradient[row->degree + 1] = below;
+            gradient[row->degree + 2] = below * s;
+            for (i = 0; i < pk; ++i)
+                for (b = 0; b < p; ++b)
+                    mapped[i * p + b] += gradient[i] * q->to_theta[g * p + b];
+        }
+        add_sandwich(mapped, row->covariance, mapped, pk, p, 1.0, q->cov_ends + k * pp);
+        if (P < 1)
+            continue;
+        for (g = 0; g < GRID_POINTS; ++g) { /* sensitivities, t^0 ... t^3 */
+            for (kk = 0; kk < P; ++kk) {
+                double base[4], again[4], width = q->loads[kk + 1] - q->loads[kk];
+                int l;
+                for (l = 0; l < L; ++l)
+                    y[l] = q->values[l * GRID_POINTS + g];
+                piece(q->loads, y, L, kk, q->pchip, base);
+                y[k] += q->delta;
+                piece(q->loads, y, L, kk, q->pchip, again);
+                for (m = 0; m < 4; ++m)
+                    sensitivity[((3 - m) * P + kk) * GRID_POINTS + g] =
+                        (again[m] - base[m]) / q->delta * pow(width, 3 - m);
+            }
+        }
+        for (kk = 0; kk < P; ++kk) {
+            memset(a, 0, (size_t)4 * P_MAX * p * sizeof *a);
+            for (g = 0; g < GRID_POINTS; ++g) {
+                double s = q->grid[g], gradient[P_MAX], below = s < 0;
+                for (i = 0; i <= row->degree; ++i)
+                    gradient[i] = pow(s, i);
+                gradient[row->degree + 1] = below;
+                gradient[row->degree + 2] = below * s;
+                for (j = 0; j < 4; ++j) {
+                    double w = sensitivity[(j * P + kk) * GRID_POINTS + g];
+                    for (i = 0; i < pk; ++i)
+                        for (b = 0; b < p; ++b)
+                            a[(j * P_MAX + i) * p + b] += gradient[i] * w
+                                                          * q->to_theta[g * p + b];
+                }
+            }
+            for (j = 0; j < 4; ++j)
+                for (jj = 0; jj < 4; ++jj)
+                    add_sandwich(a + j * P_MAX * p, row->covariance, a + jj * P_MAX * p, pk, p,
+                                 1.0, q->cov_inside + ((size_t)kk * 7 + j + jj) * pp);
+        }
+    }
+    if (L >= 3) { /* interpolation error */
+        for (kk = 0; kk < P; ++kk) {
+            double v[4][P_MAX], width = q->loads[kk + 1] - q->loads[kk];
+            memset(v, 0, sizeof v);
+            for (g = 0; g < GRID_POINTS; ++g) {
+                double cubic[4], line[4];
+                int l;
+                for (l = 0; l < L; ++l)
+                    y[l] = q->values[l * GRID_POINTS + g];
+                piece(q->loads, y, L, kk, 1, cubic);
+                piece(q->loads, y, L, kk, 0, line);
+                for (m = 0; m < 4; ++m) {
+                    double d = (cubic[m] - line[m]) * pow(width, 3 - m);
+                    for (b = 0; b < p; ++b)
+                        v[3 - m][b] += d * q->to_theta[g * p + b];
+                }
+            }
+            for (j = 0; j < 4; ++j)
+                for (jj = 0; jj < 4; ++jj)
+                    for (i = 0; i < p; ++i)
+                        for (b = 0; b < p; ++b)
+                            q->cov_inside[((size_t)kk * 7 + j + jj) * pp + i * p + b] +=
+                                v[j][i] * v[jj][b] / 3.0;
+        }
+    }
+    free(y), free(sensitivity), free(a);
+    return 0;
+}
+
 static int build_quantity(wpm_quantity *q)
 {
     int L = q->n_loads, k, g, i, j, n_solution, result;
@@ -399,7 +497,7 @@ static int build_quantity(wpm_quantity *q)
         }
         free(y);
     }
-    return 0;
+    return q->has_uncertainty ? build_covariance(q) : 0;
 }
 
 static void free_quantity(wpm_quantity *q)
@@ -413,6 +511,8 @@ static void free_quantity(wpm_quantity *q)
     free(q->values);
     free(q->at_tested);
     free(q->pieces);
+    free(q->cov_ends);
+    free(q->cov_inside);
     free(q);
 }
 
@@ -1051,9 +1151,11 @@ int swtwpm_slip_for(const swtwpm *model, int set, int quantity, double load_n, d
 int swtwpm_curve_at(const swtwpm *model, int set, int quantity, double load_n, int flags,
                     swtwpm_curve *curve, char *msg, size_t msg_size)
 {
-    double theta[P_MAX], base[GRID_POINTS], *y, sensitivity[GRID_POINTS];
+    double theta[P_MAX], t, y[2];
     const wpm_quantity *q;
-    int code, outside, L, p, k, g, i, j;
+    const double *c;
+    int code, outside, L, p, k, hi, i, j, r;
+    size_t pp;
     if (!curve)
         return SWTWPM_E_ARGUMENT;
     memset(curve, 0, sizeof *curve);
@@ -1064,6 +1166,7 @@ int swtwpm_curve_at(const swtwpm *model, int set, int quantity, double load_n, i
     outside = code != 0;
     L = q->n_loads;
     p = q->p;
+    pp = (size_t)p * p;
     curve->degree = q->degree;
     memcpy(curve->a, theta, (size_t)(q->degree + 1) * sizeof *theta);
     curve->step_below_zero = theta[q->degree + 1];
@@ -1075,83 +1178,34 @@ int swtwpm_curve_at(const swtwpm *model, int set, int quantity, double load_n, i
     curve->has_uncertainty = q->has_uncertainty;
     if (!curve->has_uncertainty)
         return code;
-    y = malloc((size_t)L * sizeof *y);
-    if (!y) {
-        wpm_message(msg, msg_size, "out of memory");
-        return SWTWPM_E_MEMORY;
-    }
-    for (g = 0; g < GRID_POINTS; ++g) {
-        for (k = 0; k < L; ++k)
-            y[k] = q->values[k * GRID_POINTS + g];
-        base[g] = across_load(q->loads, y, L, load_n, q->pchip, outside);
-    }
-    for (k = 0; k < L; ++k) { /* _propagate */
-        const wpm_row *row = q->tested[k];
-        int pk = row->degree + 3;
-        double mapped[P_MAX][P_MAX], cm[P_MAX][P_MAX];
-        for (g = 0; g < GRID_POINTS; ++g) {
-            int l;
-            for (l = 0; l < L; ++l)
-                y[l] = q->values[l * GRID_POINTS + g];
-            y[k] += q->delta;
-            sensitivity[g] = (across_load(q->loads, y, L, load_n, q->pchip, outside) - base[g])
-                             / q->delta;
-        }
-        memset(mapped, 0, sizeof mapped);
-        for (g = 0; g < GRID_POINTS; ++g) {
-            double s = q->grid[g], gradient[P_MAX], below = s < 0;
-            for (i = 0; i <= row->degree; ++i)
-                gradient[i] = pow(s, i);
-            gradient[row->degree + 1] = below;
-            gradient[row->degree + 2] = below * s;
-            for (i = 0; i < pk; ++i) {
-                double w = sensitivity[g] * gradient[i];
-                for (j = 0; j < p; ++j)
-                    mapped[i][j] += w * q->to_theta[g * p + j];
-            }
-        }
-        for (i = 0; i < pk; ++i) /* C_k mapped */
-            for (j = 0; j < p; ++j) {
-                double sum = 0;
-                int l;
-                for (l = 0; l < pk; ++l)
-                    sum += row->covariance[i][l] * mapped[l][j];
-                cm[i][j] = sum;
-            }
-        for (i = 0; i < p; ++i)
-            for (j = 0; j < p; ++j) {
-                double sum = 0;
-                int l;
-                for (l = 0; l < pk; ++l)
-                    sum += mapped[l][i] * cm[l][j];
-                curve->covariance[i][j] += sum;
-            }
-    }
-    if (L >= 3) { /* _interpolation_error: v v^T / 3, v the parameters of PCHIP - linear */
-        double v[P_MAX];
-        memset(v, 0, sizeof v);
-        for (g = 0; g < GRID_POINTS; ++g) {
-            double difference;
-            for (k = 0; k < L; ++k)
-                y[k] = q->values[k * GRID_POINTS + g];
-            difference = across_load(q->loads, y, L, load_n, 1, outside)
-                         - across_load(q->loads, y, L, load_n, 0, outside);
-            for (j = 0; j < p; ++j)
-                v[j] += difference * q->to_theta[g * p + j];
-        }
+    if (L == 1) { /* the kernel's _variance, as a matrix */
         for (i = 0; i < p; ++i)
             for (j = 0; j < p; ++j)
-                curve->covariance[i][j] += v[i] * v[j] / 3.0;
+                curve->covariance[i][j] = q->cov_ends[i * p + j];
+        curve->scatter_sd = q->tested[0]->scatter_sd > 0 ? q->tested[0]->scatter_sd : 0.0;
+        curve->k95 = q->tested[0]->k95 > 0 ? q->tested[0]->k95 : 0.0;
+        return code;
     }
-    for (k = 0; k < L; ++k)
-        y[k] = q->tested[k]->scatter_sd;
-    curve->scatter_sd = across_load(q->loads, y, L, load_n, 0, outside);
-    curve->scatter_sd = curve->scatter_sd > 0 ? curve->scatter_sd : 0.0;
-    for (k = 0; k < L; ++k)
-        y[k] = q->tested[k]->k95;
-    curve->k95 = across_load(q->loads, y, L, load_n, 0, outside);
-    curve->k95 = curve->k95 > 0 ? curve->k95 : 0.0;
-    free(y);
+    for (hi = 0; hi < L && q->loads[hi] < load_n; ++hi)
+        ;
+    k = (hi < 1 ? 1 : hi > L - 1 ? L - 1 : hi) - 1;
+    t = (load_n - q->loads[k]) / (q->loads[k + 1] - q->loads[k]);
+    for (i = 0; i < p; ++i)
+        for (j = 0; j < p; ++j) {
+            if (outside) /* linear: (1 - t)^2 D_k + t^2 D_k+1 */
+                curve->covariance[i][j] = (1.0 - t) * (1.0 - t) * q->cov_ends[k * pp + i * p + j]
+                                          + t * t * q->cov_ends[(k + 1) * pp + i * p + j];
+            else {
+                c = q->cov_inside + (size_t)k * 7 * pp + i * p + j;
+                curve->covariance[i][j] = c[6 * pp];
+                for (r = 5; r >= 0; --r)
+                    curve->covariance[i][j] = curve->covariance[i][j] * t + c[r * pp];
+            }
+        }
+    y[0] = (1.0 - t) * q->tested[k]->scatter_sd + t * q->tested[k + 1]->scatter_sd;
+    y[1] = (1.0 - t) * q->tested[k]->k95 + t * q->tested[k + 1]->k95;
+    curve->scatter_sd = y[0] > 0 ? y[0] : 0.0;
+    curve->k95 = y[1] > 0 ? y[1] : 0.0;
     return code;
 }
 
