@@ -31,6 +31,7 @@ from wpm_export import WpmFormatError, read_wpm_csv
 
 BENCH = ROOT / "libswtwpm" / "tools" / "bench_queries.c"
 GOAL_PER_S = 5e6
+COMMAND = "python -m bench wpm_c --markdown"
 
 
 def _c_rates(path: Path, folder: Path, n: int) -> tuple[dict[str, float], dict[str, float]]:
@@ -125,7 +126,52 @@ def main(quick: bool = False) -> dict:
         print(fuzz["report"])
     return {"c_per_cpu_s": c, "python_per_cpu_s": py, "c_per_wall_s": c_wall,
             "python_per_wall_s": py_wall, "ratio_cpu": {k: c[k] / py[k] for k in py},
-            "goal_per_s": GOAL_PER_S, "load_average_1min": os.getloadavg()[0], "fuzz": fuzz}
+            "goal_per_s": GOAL_PER_S, "load_average_1min": os.getloadavg()[0],
+            "cores": os.cpu_count(), "quick": quick, "fuzz": fuzz}
+
+
+def markdown(numbers: dict) -> str:
+    """docs/validation/wpm_c.md from a run's numbers."""
+    c, py, c_wall, py_wall = (numbers[k] for k in ("c_per_cpu_s", "python_per_cpu_s",
+                                                    "c_per_wall_s", "python_per_wall_s"))
+    fuzz = numbers["fuzz"]
+    lines = [
+        "# libswtwpm (C): queries per second at random loads, and the fuzz run",
+        "",
+        f"Regenerate with `{COMMAND}` (bench/bench_wpm_c.py; its docstring defines the cases). "
+        "One scalar call per query, each at a fresh random load in the tested 70-300 N, as a "
+        "simulator asks once per time step; the Python runtime's scalar calls in the same "
+        f"run. This run: {numbers['cores']} cores, 1-minute load average "
+        f"{numbers['load_average_1min']:.1f} (a shared machine: rates per CPU second of each "
+        "process, the ratios from them; per wall second beside them)"
+        + (", quick sizes" if numbers["quick"] else "") + ".",
+        "",
+        f"Goal (issue 37.2): >= {GOAL_PER_S:,.0f} scalar queries per second in C.",
+        "",
+        "| scalar query | C, per CPU s | Python, per CPU s | ratio | C, per wall s | "
+        "Python, per wall s |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
+    for kind, label in (("forward", "forward: `swtwpm_value` (Python: `band_one`)"),
+                        ("inverse", "inverse: `swtwpm_slip_for` (Python: `slip_for_one`)"),
+                        ("band", "forward with 95 % bands: `swtwpm_value_band` (Python: "
+                                 "`band_one`)")):
+        lines.append(f"| {label} | {c[kind]:,.0f} | {py[kind]:,.0f} | "
+                     f"{c[kind] / py[kind]:.1f}x | {c_wall[kind]:,.0f} | {py_wall[kind]:,.0f} |")
+    lines += [
+        "",
+        f"Fuzz: {fuzz['mutants']:,} mutated WPM CSVs (bench/wpm_fuzz.py) through the reader "
+        f"and every query under AddressSanitizer + UBSan: {fuzz['findings']} findings; "
+        f"{fuzz['read']:,} read, {fuzz['refused']:,} refused ({fuzz['silent']} without a "
+        f"message); the C and the Python reader agree on {fuzz['agree_with_python']:,} "
+        f"(NUL bytes, refused by C only: {fuzz['disagree_nul_byte']}; Python reader "
+        f"crashes: {fuzz['python_reader_crashes']}).",
+        "",
+        "Answers: C and the Python runtime agree within 1e-9 (tests/test_wpm_clib.py, "
+        "100,000 random queries).",
+        "",
+    ]
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ runtime, only the documented method (docs/wpm-csv.md)."""
 
 from __future__ import annotations
 
+import csv
 import shutil
 import warnings
 from pathlib import Path
@@ -168,6 +169,32 @@ def test_edges_beyond_the_maximum_below_the_minimum_and_inside_the_step(files):
             assert step.status == py.slip_for(q, mid, load, multipass=0).status
             if not reached_before:
                 assert step.status == "at_step" and step.slip == 0.0 and step.value == mid
+
+
+def test_targets_inside_a_jump_at_zero_slip_give_at_step_in_both(files, tmp_path):
+    """dp_n's curves given a jump up at zero slip (step_below_zero -20 N: the braked side
+    ends 20 N below the driven one): targets in the jump and not reached below zero give
+    slip 0.0 and ``at_step``, the same in C and Python, at random loads."""
+    rows = list(csv.reader(files["full"].read_text().splitlines()))
+    header = next(r for r in rows if r and r[0] == "soil")
+    step = header.index("step_below_zero")
+    for r in rows:
+        if len(r) == len(header) and r[4] == "dp_n":
+            r[step] = "-20.0"
+    path = tmp_path / "jump.csv"
+    path.write_text("\n".join(",".join(r) for r in rows) + "\n")
+    py, c = WheelPerformanceModule.load(path), CWheelPerformanceModule(path)
+    rng = np.random.default_rng(5)
+    loads = rng.uniform(70.0, 300.0, 2000)
+    at_zero = py.at_slip(0.0, loads, multipass=0)["dp_n"]
+    targets = at_zero - rng.uniform(-5.0, 25.0, loads.size)  # across the jump and around it
+    want = py.slip_for("dp_n", targets, loads, multipass=0)
+    have = c.slip_for("dp_n", targets, loads, multipass=0)
+    assert np.array_equal(want.status, have.status)
+    assert (want.status == "at_step").sum() > 100
+    np.testing.assert_allclose(have.slip, want.slip, rtol=0, atol=RTOL)
+    np.testing.assert_allclose(have.value, want.value, rtol=0, atol=RTOL * 100.0)
+    assert np.all(have.slip[have.status == "at_step"] == 0.0)
 
 
 def _message(call) -> tuple[type, str]:
