@@ -135,6 +135,8 @@ def markdown(numbers: dict) -> str:
     c, py, c_wall, py_wall = (numbers[k] for k in ("c_per_cpu_s", "python_per_cpu_s",
                                                     "c_per_wall_s", "python_per_wall_s"))
     fuzz = numbers["fuzz"]
+    other = (fuzz["mutants"] - fuzz["agree_with_python"] - fuzz["python_reader_crashes"]
+             - fuzz["disagree_nul_byte"])
     lines = [
         "# libswtwpm (C): queries per second at random loads, and the fuzz run",
         "",
@@ -163,9 +165,10 @@ def markdown(numbers: dict) -> str:
         f"Fuzz: {fuzz['mutants']:,} mutated WPM CSVs (bench/wpm_fuzz.py) through the reader "
         f"and every query under AddressSanitizer + UBSan: {fuzz['findings']} findings; "
         f"{fuzz['read']:,} read, {fuzz['refused']:,} refused ({fuzz['silent']} without a "
-        f"message); the C and the Python reader agree on {fuzz['agree_with_python']:,} "
-        f"(NUL bytes, refused by C only: {fuzz['disagree_nul_byte']}; Python reader "
-        f"crashes: {fuzz['python_reader_crashes']}).",
+        f"message); the C and the Python reader agree on {fuzz['agree_with_python']:,} of "
+        f"them, disagree on {fuzz['disagree_nul_byte']} holding a NUL byte (refused by C "
+        f"only) and on {other} others; the Python reader crashed on "
+        f"{fuzz['python_reader_crashes']}.",
         "",
         "Answers: C and the Python runtime agree within 1e-9 (tests/test_wpm_clib.py, "
         "100,000 random queries).",
