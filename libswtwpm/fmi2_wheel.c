@@ -9,8 +9,8 @@
  *   2 sinkage_m, 3 resistance_n), 40 status (output, Integer: 0 ok, > 0 warning flags,
  *   < 0 a swtwpm error code).
  * A query the library refuses (a load outside the tested ones, NaN, another wheel) sets the
- * outputs to NaN, logs the library's message and returns fmi2Error from fmi2GetReal /
- * fmi2DoStep. The FMI 2.0 types and signatures are written out here (FMI 2.0 standard,
+ * outputs to NaN, logs the library's message (the Python runtime's, dp_n's first) and
+ * returns fmi2Error from fmi2GetReal; an extrapolated load (allowed) logs its warning. The FMI 2.0 types and signatures are written out here (FMI 2.0 standard,
  * fmi2TypesPlatform.h / fmi2FunctionTypes.h, with the standard's names). */
 #include <math.h>
 #include <stdarg.h>
@@ -71,11 +71,11 @@ static void say(wheel_fmu *w, fmi2Status status, const char *format, ...)
                         status == fmi2OK ? "logAll" : "logStatusError", "%s", text);
 }
 
-/* the outputs at the current inputs (the half-widths only when asked for: they cost a
- * covariance per load): fmi2OK, fmi2Warning or fmi2Error (message logged) */
+/* the outputs at the current inputs (the half-widths only when asked for): fmi2OK,
+ * fmi2Warning or fmi2Error (message logged) */
 static fmi2Status update(wheel_fmu *w, int bands)
 {
-    char msg[1024] = "";
+    char msg[1024] = "", warning[1024] = "";
     int set, q, worst = 0;
     if (!w->dirty && !(bands && w->bands_dirty))
         return w->status < 0 ? fmi2Error : w->status > 0 ? fmi2Warning : fmi2OK;
@@ -109,12 +109,13 @@ static fmi2Status update(wheel_fmu *w, int bands)
             say(w, fmi2Error, "t = %g s: %s", w->time, msg);
             return fmi2Error;
         }
+        if (code & SWTWPM_WARN_LOAD_EXTRAPOLATED && !*warning)
+            strcpy(warning, msg);
         worst |= code;
     }
     w->status = worst;
-    if (worst & SWTWPM_WARN_LOAD_EXTRAPOLATED)
-        say(w, fmi2Warning, "t = %g s: load %g N extrapolated beyond the tested loads", w->time,
-            w->load_n);
+    if (*warning)
+        say(w, fmi2Warning, "t = %g s: %s", w->time, warning);
     return fmi2OK;
 }
 

@@ -13,7 +13,9 @@
  * Return codes: 0 = answered; > 0 = answered with warnings (bit flags SWTWPM_WARN_*);
  * < 0 = error (SWTWPM_E_*), outputs NaN. Every function that can fail takes an optional
  * message buffer (msg, msg_size; NULL/0 for none) and writes one line there: the same text
- * as the Python runtime's error for the same problem. Nothing here aborts, exits or prints.
+ * as the Python runtime's error or warning for the same problem (docs/wpm-csv.md, "Errors of
+ * a query"); where a query has two warnings the load's is the message. Nothing here aborts,
+ * exits or prints.
  * A loaded model is read-only: queries from several threads on one model are safe.
  */
 #ifndef SWTWPM_H
@@ -137,8 +139,9 @@ int swtwpm_value(const swtwpm *model, int set, int quantity, double load_n, doub
 int swtwpm_slip_for(const swtwpm *model, int set, int quantity, double load_n, double target,
                     int flags, double *slip, double *value, int *status, char *msg,
                     size_t msg_size);
-/* The curve at load_n with its covariance (what the bands need; costs more than a value:
- * compute it once per load and evaluate it at many slips). */
+/* The curve at load_n with its covariance (what the bands need: the covariance is a
+ * polynomial of load precomputed at open, evaluated here; to ask many slips at one load,
+ * compute it once and evaluate it at each). */
 int swtwpm_curve_at(const swtwpm *model, int set, int quantity, double load_n, int flags,
                     swtwpm_curve *curve, char *msg, size_t msg_size);
 /* The curve's value and 95 % half-widths at slip: conf95 = k95 sqrt(g'Cg) (where the true

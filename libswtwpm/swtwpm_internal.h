@@ -7,7 +7,6 @@
 #include "swtwpm.h"
 
 #define GRID_POINTS 101 /* Chebyshev-Lobatto slips of the refit across load (docs/wpm-csv.md) */
-#define CELLS 16        /* cells of the inverse's row solver (wpm_export/inverse.py) */
 
 /* one row of the file */
 typedef struct {
@@ -21,13 +20,6 @@ typedef struct {
     double k95, scatter_sd;
     double covariance[SWTWPM_MAX_PARAMETERS][SWTWPM_MAX_PARAMETERS];
 } wpm_row;
-
-/* the cells of the inverse's row solver for one layout of sides */
-typedef struct {
-    int n_sides, count0, points; /* count0: cells of the first side (the jump cell index) */
-    double *grid;                /* points */
-    double *power, *slope_power; /* points x (degree + 1): s^i and i s^(i-1) */
-} wpm_cells;
 
 /* one quantity of one curve set: the tested curves and what the interpolation across load
  * precomputes (fitting/load_interp.py) */
@@ -44,7 +36,8 @@ typedef struct {
     double *at_tested; /* L x p */
     double *pieces;    /* 4 x (L - 1) x p: parameters cubic in (load - loads[k]) */
     double delta;      /* forward-difference step of the covariance propagation */
-    wpm_cells cells[2]; /* [0] one polynomial over the range, [1] braked + driven sides */
+    double *cov_ends;   /* L x p x p: each tested curve's covariance mapped to parameters */
+    double *cov_inside; /* (L - 1) x 7 x p x p: covariance, coefficients of t^0 ... t^6 */
 } wpm_quantity;
 
 typedef struct {
@@ -80,5 +73,7 @@ void wpm_message(char *msg, size_t msg_size, const char *format, ...);
 const char *wpm_g(double x, char buffer[32]);
 /* repr() of a Python float */
 void wpm_repr(double x, char buffer[40]);
+/* repr() of a Python str (quotes, escapes of control characters), cut to size */
+void wpm_repr_text(const char *s, char *buffer, size_t size);
 
 #endif

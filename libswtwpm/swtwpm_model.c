@@ -10,10 +10,19 @@
  *   tested loads: linear from the two nearest, only when asked;
  * - the covariance at a load: the tested curves' propagated through the interpolation (its
  *   sensitivity by the same forward difference as Python), plus with 3+ loads the
- *   PCHIP-minus-linear interpolation error v v^T / 3; scatter_sd and k95 linear in load;
- * - the inverse: the row solver of wpm_export/inverse.py (16 cells over the slip range,
- *   turning points located in each cell, running extremes, safeguarded Newton). */
+ *   PCHIP-minus-linear interpolation error v v^T / 3, precomputed as a polynomial of load
+ *   (sextic in t per interval, LoadPolynomial.covariance_pieces); scatter_sd and k95 linear
+ *   in load;
+ * - the inverse (wpm_export/kernel.py, the same operations): each side of zero slip cut
+ *   at the curve's turning points at the load (the real roots of its derivative in the
+ *   range, isolated by those of the next derivative, recursively down to a quadratic) into
+ *   monotone pieces; the first piece in slip order whose values span the target holds the
+ *   smallest slip, found by safeguarded Newton; the jump at zero slip is a piece of its own.
+ *
+ * Error and warning messages are the Python runtime's (wpm_export/runtime.py), word for
+ * word: they name the keyword argument of the Python call (load_n=..., target=...). */
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,42 +50,8 @@ static double sign(double x)
     return isnan(x) ? x : (double)((x > 0) - (x < 0));
 }
 
-/* numpy.maximum / minimum: NaN propagates */
+/* numpy.maximum: NaN propagates */
 static double np_max(double a, double b) { return (a > b || isnan(a)) ? a : b; }
-static double np_min(double a, double b) { return (a < b || isnan(a)) ? a : b; }
-/* numpy.fmax / fmin: NaN ignored */
-static double np_fmax(double a, double b) { return isnan(b) ? a : isnan(a) ? b : np_max(a, b); }
-static double np_fmin(double a, double b) { return isnan(b) ? a : isnan(a) ? b : np_min(a, b); }
-
-/* Root of polynomial c (n coefficients) in [a, b] (a sign change or a root at an end):
- * safeguarded Newton from the secant point, as inverse.py _root. */
-static double root(const double *c, int n, double a, double b)
-{
-    double slope[SWTWPM_MAX_DEGREE + 1], fa, fb, secant, x;
-    int i, iteration;
-    for (i = 1; i < n; ++i)
-        slope[i - 1] = c[i] * i;
-    fa = horner(c, n, a);
-    fb = horner(c, n, b);
-    secant = a - fa * (b - a) / (fb - fa);
-    x = fa == 0 ? a : fb == 0 ? b : (secant > a && secant < b) ? secant : 0.5 * (a + b);
-    if (fa == 0 || fb == 0)
-        return x;
-    for (iteration = 0; iteration < MAX_ITERATIONS; ++iteration) {
-        double fx = horner(c, n, x), dfx = horner(slope, n - 1, x), newton, step, xl = x;
-        if (sign(fx) == sign(fa)) {
-            a = x;
-            fa = fx;
-        } else
-            b = x;
-        newton = x - fx / dfx;
-        step = fx == 0 ? 0.0 : ((newton > a && newton < b) ? newton : 0.5 * (a + b)) - x;
-        x = xl + step;
-        if (!(fabs(step) > STEP_TOLERANCE * (1.0 + fabs(xl))))
-            break;
-    }
-    return x;
-}
 
 /* ---- PCHIP across load at one slip (scipy's arithmetic) ---- */
 
@@ -127,50 +102,6 @@ static void pchip_piece(const double *x, const double *y, int L, int i, double c
     c[1] = (slope - d0) / dx - t;
     c[2] = d0;
     c[3] = y[i];
-}
-
-/* the PPoly interval of w inside [x[0], x[L-1]] */
-static int pchip_interval(const double *x, int L, double w)
-{
-    int i = 0;
-    if (w >= x[L - 1])
-        return L - 2;
-    while (i < L - 2 && w >= x[i + 1])
-        ++i;
-    return i;
-}
-
-static double pchip_at(const double *x, const double *y, int L, double w)
-{
-    double c[4], s, z, out;
-    int i = pchip_interval(x, L, w);
-    pchip_piece(x, y, L, i, c);
-    s = w - x[i];
-    out = 0.0 + c[3];
-    z = s;
-    out = out + c[2] * z;
-    z *= s;
-    out = out + c[1] * z;
-    z *= s;
-    out = out + c[0] * z;
-    return out;
-}
-
-/* _across_load of one slip's values y over the tested loads x, at w */
-static double across_load(const double *x, const double *y, int L, double w, int pchip,
-                          int outside)
-{
-    int hi;
-    double t;
-    if (L == 1)
-        return y[0];
-    if (pchip && !outside)
-        return pchip_at(x, y, L, w);
-    for (hi = 0; hi < L && x[hi] < w; ++hi) /* searchsorted, side left */
-        ;
-    hi = hi < 1 ? 1 : hi > L - 1 ? L - 1 : hi;
-    t = (w - x[hi - 1]) / (x[hi] - x[hi - 1]);
-    return (1.0 - t) * y[hi - 1] + t * y[hi];
 }
 
 /* ---- least squares: pseudo-inverse by one-sided Jacobi SVD ---- */
@@ -287,51 +218,6 @@ static int branch_terms(const wpm_row *row)
     return row->slope != 0 ? 2 : row->step != 0 ? 1 : 0;
 }
 
-/* numpy.linspace(lo, hi, n + 1) into out */
-static void linspace(double lo, double hi, int n, double *out)
-{
-    double delta = hi - lo, step = delta / n;
-    int i;
-    for (i = 0; i <= n; ++i)
-        out[i] = (step == 0 ? (i / (double)n) * delta : i * step) + lo;
-    out[n] = hi;
-}
-
-/* the cells of the row solver: one side over [lo, hi], or two split at zero slip */
-static int build_cells(wpm_quantity *q, int two_sides, wpm_cells *cells)
-{
-    double width = q->hi - q->lo, bounds[2][2];
-    int counts[2], side, g, i, n = q->degree + 1, at = 0;
-    cells->n_sides = two_sides ? 2 : 1;
-    if (two_sides) {
-        bounds[0][0] = q->lo, bounds[0][1] = 0.0, bounds[1][0] = 0.0, bounds[1][1] = q->hi;
-    } else
-        bounds[0][0] = q->lo, bounds[0][1] = q->hi;
-    cells->points = 0;
-    for (side = 0; side < cells->n_sides; ++side) {
-        double cells_here = nearbyint(CELLS * (bounds[side][1] - bounds[side][0]) / width);
-        counts[side] = cells_here > 4 ? (int)cells_here : 4;
-        cells->points += counts[side] + 1;
-    }
-    cells->count0 = counts[0];
-    cells->grid = malloc((size_t)cells->points * sizeof *cells->grid);
-    cells->power = malloc((size_t)cells->points * n * sizeof *cells->power);
-    cells->slope_power = malloc((size_t)cells->points * n * sizeof *cells->slope_power);
-    if (!cells->grid || !cells->power || !cells->slope_power)
-        return SWTWPM_E_MEMORY;
-    for (side = 0; side < cells->n_sides; ++side) {
-        linspace(bounds[side][0], bounds[side][1], counts[side], cells->grid + at);
-        at += counts[side] + 1;
-    }
-    for (g = 0; g < cells->points; ++g)
-        for (i = 0; i < n; ++i) {
-            cells->power[i * cells->points + g] = pow(cells->grid[g], i);
-            cells->slope_power[i * cells->points + g] = i > 0 ? i * pow(cells->grid[g], i - 1)
-                                                              : 0.0;
-        }
-    return 0;
-}
-
 static double curve_value(const wpm_row *row, double s)
 {
     double y = horner(row->a, row->degree + 1, s);
@@ -344,6 +230,146 @@ static int compare_loads(const void *a, const void *b)
 {
     double x = (*(const wpm_row *const *)a)->load_n, y = (*(const wpm_row *const *)b)->load_n;
     return (x > y) - (x < y);
+}
+
+/* the four coefficients (of (w - x[i])^3 ... ^0) of interval i across load: PCHIP, or
+ * linear (fitting.load_interp._linear_pieces) */
+static void piece(const double *x, const double *y, int L, int i, int pchip, double c[4])
+{
+    if (pchip) {
+        pchip_piece(x, y, L, i, c);
+        return;
+    }
+    c[0] = c[1] = 0.0;
+    c[2] = (y[i + 1] - y[i]) / (x[i + 1] - x[i]);
+    c[3] = y[i];
+}
+
+/* out (p x p) += A^T C B, A and B pk x p (row-major), C the pk x pk covariance */
+static void add_sandwich(const double *a, const double covariance[P_MAX][P_MAX],
+                         const double *b, int pk, int p, double scale, double *out)
+{
+    double cb[P_MAX * P_MAX];
+    int i, j, l;
+    for (i = 0; i < pk; ++i)
+        for (j = 0; j < p; ++j) {
+            double sum = 0.0;
+            for (l = 0; l < pk; ++l)
+                sum += covariance[i][l] * b[l * p + j];
+            cb[i * p + j] = sum;
+        }
+    for (i = 0; i < p; ++i)
+        for (j = 0; j < p; ++j) {
+            double sum = 0.0;
+            for (l = 0; l < pk; ++l)
+                sum += a[l * p + i] * cb[l * p + j];
+            out[i * p + j] += scale * sum;
+        }
+}
+
+/* The covariance of the parameters as a polynomial of load
+ * (fitting.load_interp.LoadPolynomial.covariance_pieces): ends (L x p x p), each tested
+ * curve's covariance mapped to the parameters; inside ((L - 1) x 7 x p x p), the
+ * coefficients of t^r between tested loads k and k + 1 (t = (load - loads[k]) / width):
+ * the propagated tested covariances (forward-difference sensitivities of the across-load
+ * pieces, cubic in t, their products sextic) plus, with 3+ loads, the interpolation error
+ * v v^T / 3 (v: the parameters of PCHIP less linear). */
+static int build_covariance(wpm_quantity *q)
+{
+    int L = q->n_loads, P = L - 1, p = q->p, k, kk, g, i, j, jj, b, m;
+    size_t pp = (size_t)p * p;
+    double *y = malloc((size_t)L * sizeof *y), *sensitivity = NULL, *a = NULL;
+    q->cov_ends = calloc((size_t)L * pp, sizeof *q->cov_ends);
+    q->cov_inside = calloc((size_t)(P > 0 ? P : 1) * 7 * pp, sizeof *q->cov_inside);
+    if (P > 0) {
+        sensitivity = malloc((size_t)4 * P * GRID_POINTS * sizeof *sensitivity);
+        a = malloc((size_t)4 * P_MAX * p * sizeof *a);
+    }
+    if (!y || !q->cov_ends || !q->cov_inside || (P > 0 && (!sensitivity || !a))) {
+        free(y), free(sensitivity), free(a);
+        return SWTWPM_E_MEMORY;
+    }
+    for (k = 0; k < L; ++k) {
+        const wpm_row *row = q->tested[k];
+        int pk = row->degree + 3;
+        double mapped[P_MAX * P_MAX];
+        memset(mapped, 0, sizeof mapped);
+        for (g = 0; g < GRID_POINTS; ++g) { /* parameter_gradient(grid).T @ to_theta */
+            double s = q->grid[g], gradient[P_MAX], below = s < 0;
+            for (i = 0; i <= row->degree; ++i)
+                gradient[i] = pow(s, i);
+            gradient[row->degree + 1] = below;
+            gradient[row->degree + 2] = below * s;
+            for (i = 0; i < pk; ++i)
+                for (b = 0; b < p; ++b)
+                    mapped[i * p + b] += gradient[i] * q->to_theta[g * p + b];
+        }
+        add_sandwich(mapped, row->covariance, mapped, pk, p, 1.0, q->cov_ends + k * pp);
+        if (P < 1)
+            continue;
+        for (g = 0; g < GRID_POINTS; ++g) { /* sensitivities, t^0 ... t^3 */
+            for (kk = 0; kk < P; ++kk) {
+                double base[4], again[4], width = q->loads[kk + 1] - q->loads[kk];
+                int l;
+                for (l = 0; l < L; ++l)
+                    y[l] = q->values[l * GRID_POINTS + g];
+                piece(q->loads, y, L, kk, q->pchip, base);
+                y[k] += q->delta;
+                piece(q->loads, y, L, kk, q->pchip, again);
+                for (m = 0; m < 4; ++m)
+                    sensitivity[((3 - m) * P + kk) * GRID_POINTS + g] =
+                        (again[m] - base[m]) / q->delta * pow(width, 3 - m);
+            }
+        }
+        for (kk = 0; kk < P; ++kk) {
+            memset(a, 0, (size_t)4 * P_MAX * p * sizeof *a);
+            for (g = 0; g < GRID_POINTS; ++g) {
+                double s = q->grid[g], gradient[P_MAX], below = s < 0;
+                for (i = 0; i <= row->degree; ++i)
+                    gradient[i] = pow(s, i);
+                gradient[row->degree + 1] = below;
+                gradient[row->degree + 2] = below * s;
+                for (j = 0; j < 4; ++j) {
+                    double w = sensitivity[(j * P + kk) * GRID_POINTS + g];
+                    for (i = 0; i < pk; ++i)
+                        for (b = 0; b < p; ++b)
+                            a[(j * P_MAX + i) * p + b] += gradient[i] * w
+                                                          * q->to_theta[g * p + b];
+                }
+            }
+            for (j = 0; j < 4; ++j)
+                for (jj = 0; jj < 4; ++jj)
+                    add_sandwich(a + j * P_MAX * p, row->covariance, a + jj * P_MAX * p, pk, p,
+                                 1.0, q->cov_inside + ((size_t)kk * 7 + j + jj) * pp);
+        }
+    }
+    if (L >= 3) { /* interpolation error */
+        for (kk = 0; kk < P; ++kk) {
+            double v[4][P_MAX], width = q->loads[kk + 1] - q->loads[kk];
+            memset(v, 0, sizeof v);
+            for (g = 0; g < GRID_POINTS; ++g) {
+                double cubic[4], line[4];
+                int l;
+                for (l = 0; l < L; ++l)
+                    y[l] = q->values[l * GRID_POINTS + g];
+                piece(q->loads, y, L, kk, 1, cubic);
+                piece(q->loads, y, L, kk, 0, line);
+                for (m = 0; m < 4; ++m) {
+                    double d = (cubic[m] - line[m]) * pow(width, 3 - m);
+                    for (b = 0; b < p; ++b)
+                        v[3 - m][b] += d * q->to_theta[g * p + b];
+                }
+            }
+            for (j = 0; j < 4; ++j)
+                for (jj = 0; jj < 4; ++jj)
+                    for (i = 0; i < p; ++i)
+                        for (b = 0; b < p; ++b)
+                            q->cov_inside[((size_t)kk * 7 + j + jj) * pp + i * p + b] +=
+                                v[j][i] * v[jj][b] / 3.0;
+        }
+    }
+    free(y), free(sensitivity), free(a);
+    return 0;
 }
 
 static int build_quantity(wpm_quantity *q)
@@ -471,15 +497,11 @@ static int build_quantity(wpm_quantity *q)
         }
         free(y);
     }
-    result = build_cells(q, 0, &q->cells[0]);
-    if (!result && q->lo < 0 && 0 <= q->hi)
-        result = build_cells(q, 1, &q->cells[1]);
-    return result;
+    return q->has_uncertainty ? build_covariance(q) : 0;
 }
 
 static void free_quantity(wpm_quantity *q)
 {
-    int c;
     if (!q)
         return;
     free(q->error);
@@ -489,11 +511,8 @@ static void free_quantity(wpm_quantity *q)
     free(q->values);
     free(q->at_tested);
     free(q->pieces);
-    for (c = 0; c < 2; ++c) {
-        free(q->cells[c].grid);
-        free(q->cells[c].power);
-        free(q->cells[c].slope_power);
-    }
+    free(q->cov_ends);
+    free(q->cov_inside);
     free(q);
 }
 
@@ -590,59 +609,71 @@ int swtwpm_set_info(const swtwpm *model, int set, const char **soil, const char 
     return 0;
 }
 
-static size_t append_set(char *out, size_t size, size_t at, const wpm_set *set, int first)
+/* printf to out + *at, at most up to size (the text cut, NUL-terminated) */
+static void append(char *out, size_t size, size_t *at, const char *format, ...)
 {
+    va_list args;
     int n;
-    if (at >= size)
-        return at;
-    n = snprintf(out + at, size - at, "%s--soil %s --wheel %s --multipass %lld",
-                 first ? "" : "; ", set->soil, set->wheel, set->multipass);
-    return n < 0 ? at : at + (size_t)n;
+    if (!out || *at + 1 >= size)
+        return;
+    va_start(args, format);
+    n = vsnprintf(out + *at, size - *at, format, args);
+    va_end(args);
+    *at = n < 0 ? *at : *at + (size_t)n < size ? *at + (size_t)n : size - 1;
+}
+
+/* "soil='a', wheel='b', multipass=0" (runtime._selection_text; NULL / negative: None) */
+static void append_selection(char *out, size_t size, size_t *at, const char *soil,
+                             const char *wheel, long long multipass)
+{
+    char text[2][1024];
+    wpm_repr_text(soil ? soil : "", text[0], sizeof text[0]);
+    wpm_repr_text(wheel ? wheel : "", text[1], sizeof text[1]);
+    append(out, size, at, "soil=%s, wheel=%s, multipass=", soil ? text[0] : "None",
+           wheel ? text[1] : "None");
+    if (multipass < 0)
+        append(out, size, at, "None");
+    else
+        append(out, size, at, "%lld", multipass);
+}
+
+static int matches(const wpm_set *set, const char *soil, const char *wheel,
+                   long long multipass)
+{
+    return (!soil || !strcmp(soil, set->soil)) && (!wheel || !strcmp(wheel, set->wheel))
+           && (multipass < 0 || multipass == set->multipass);
 }
 
 int swtwpm_select(const swtwpm *model, const char *soil, const char *wheel, long long multipass,
                   char *msg, size_t msg_size)
 {
-    int s, found = -1, count = 0;
-    size_t at;
-    char multipass_text[32];
+    int s, found = -1, count = 0, first = 1;
+    size_t at = 0;
     if (!model)
         return SWTWPM_E_ARGUMENT;
-    for (s = 0; s < model->n_sets; ++s) {
-        const wpm_set *set = &model->sets[s];
-        if ((!soil || !strcmp(soil, set->soil)) && (!wheel || !strcmp(wheel, set->wheel))
-            && (multipass < 0 || multipass == set->multipass)) {
+    for (s = 0; s < model->n_sets; ++s)
+        if (matches(&model->sets[s], soil, wheel, multipass)) {
             found = found < 0 ? s : found;
             ++count;
         }
-    }
     if (count == 1)
         return found;
     if (!msg || !msg_size)
         return SWTWPM_E_SELECTION;
-    if (multipass < 0)
-        strcpy(multipass_text, "None");
-    else
-        snprintf(multipass_text, sizeof multipass_text, "%lld", multipass);
+    msg[0] = '\0';
     if (!count) {
-        int n = snprintf(msg, msg_size, "no curves for soil=%s wheel=%s multipass=%s in %s; "
-                         "choices: ", soil ? soil : "None", wheel ? wheel : "None",
-                         multipass_text, model->name);
-        at = n < 0 ? 0 : (size_t)n;
-        for (s = 0; s < model->n_sets; ++s)
-            at = append_set(msg, msg_size, at, &model->sets[s], !s);
-    } else {
-        int n = snprintf(msg, msg_size, "%d curve sets match in %s; pick one: ", count,
-                         model->name), first = 1;
-        at = n < 0 ? 0 : (size_t)n;
-        for (s = 0; s < model->n_sets; ++s) {
-            const wpm_set *set = &model->sets[s];
-            if ((!soil || !strcmp(soil, set->soil)) && (!wheel || !strcmp(wheel, set->wheel))
-                && (multipass < 0 || multipass == set->multipass)) {
-                at = append_set(msg, msg_size, at, set, first);
-                first = 0;
-            }
-        }
+        append(msg, msg_size, &at, "no curves for ");
+        append_selection(msg, msg_size, &at, soil, wheel, multipass);
+        append(msg, msg_size, &at, " in %s; choices: ", model->name);
+    } else
+        append(msg, msg_size, &at, "%d curve sets match in %s; pick one: ", count, model->name);
+    for (s = 0; s < model->n_sets; ++s) {
+        const wpm_set *set = &model->sets[s];
+        if (count && !matches(set, soil, wheel, multipass))
+            continue;
+        append(msg, msg_size, &at, first ? "" : "; ");
+        append_selection(msg, msg_size, &at, set->soil, set->wheel, set->multipass);
+        first = 0;
     }
     return SWTWPM_E_SELECTION;
 }
@@ -660,7 +691,7 @@ static const wpm_quantity *quantity_of(const swtwpm *model, int set, int quantit
     const wpm_set *s;
     const wpm_quantity *q;
     int k, first = 1;
-    size_t at;
+    size_t at = 0;
     if (!model || set < 0 || set >= model->n_sets || quantity < 0
         || quantity >= SWTWPM_N_QUANTITIES) {
         wpm_message(msg, msg_size, "no curve set %d or quantity %d", set, quantity);
@@ -670,19 +701,15 @@ static const wpm_quantity *quantity_of(const swtwpm *model, int set, int quantit
     s = &model->sets[set];
     q = s->quantity[quantity];
     if (!q) {
-        if (msg && msg_size) {
-            int n = snprintf(msg, msg_size, "no %s curves for ('%s', '%s', %lld) in %s; it has ",
-                             swtwpm_quantity_name(quantity), s->soil, s->wheel, s->multipass,
-                             model->name);
-            at = n < 0 ? 0 : (size_t)n;
-            for (k = 0; k < SWTWPM_N_QUANTITIES; ++k)
-                if (s->quantity[k] && at < msg_size) {
-                    n = snprintf(msg + at, msg_size - at, "%s%s", first ? "" : ", ",
-                                 swtwpm_quantity_name(k));
-                    at += n < 0 ? 0 : (size_t)n;
-                    first = 0;
-                }
-        }
+        append(msg, msg_size, &at, "quantity='%s': no such curves for ",
+               swtwpm_quantity_name(quantity));
+        append_selection(msg, msg_size, &at, s->soil, s->wheel, s->multipass);
+        append(msg, msg_size, &at, " in %s; it has ", model->name);
+        for (k = 0; k < SWTWPM_N_QUANTITIES; ++k)
+            if (s->quantity[k]) {
+                append(msg, msg_size, &at, "%s%s", first ? "" : ", ", swtwpm_quantity_name(k));
+                first = 0;
+            }
         *code = SWTWPM_E_SELECTION;
         return NULL;
     }
@@ -722,24 +749,57 @@ int swtwpm_slip_range(const swtwpm *model, int set, int quantity, double *slip_m
     return 0;
 }
 
+static int compare_text(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* Python's repr of the sorted list of the model's wheel names: ['a', 'b'] */
+static void append_wheels(const swtwpm *model, char *msg, size_t msg_size, size_t *at)
+{
+    const char **names = malloc((size_t)(model->n_sets ? model->n_sets : 1) * sizeof *names);
+    char text[1024];
+    int s, first = 1;
+    if (!names)
+        return;
+    for (s = 0; s < model->n_sets; ++s)
+        names[s] = model->sets[s].wheel;
+    qsort((void *)names, (size_t)model->n_sets, sizeof *names, compare_text);
+    append(msg, msg_size, at, "[");
+    for (s = 0; s < model->n_sets; ++s)
+        if (!s || strcmp(names[s - 1], names[s])) {
+            wpm_repr_text(names[s], text, sizeof text);
+            append(msg, msg_size, at, "%s%s", first ? "" : ", ", text);
+            first = 0;
+        }
+    append(msg, msg_size, at, "]");
+    free((void *)names);
+}
+
 int swtwpm_wheel_geometry(const swtwpm *model, const char *wheel, double geometry[5],
                           char *msg, size_t msg_size)
 {
     int s, w;
     const char *name = wheel;
+    char text[1024];
+    size_t at = 0;
     if (!model || !geometry)
         return SWTWPM_E_ARGUMENT;
     for (s = 0; !wheel && s < model->n_sets; ++s) {
         if (name && strcmp(name, model->sets[s].wheel)) {
-            wpm_message(msg, msg_size, "%s: several wheels; name one", model->name);
+            append(msg, msg_size, &at, "%s: several wheels ", model->name);
+            append_wheels(model, msg, msg_size, &at);
+            append(msg, msg_size, &at, "; name one");
             return SWTWPM_E_SELECTION;
         }
         name = model->sets[s].wheel;
     }
-    for (s = 0; s < model->n_sets && strcmp(name, model->sets[s].wheel); ++s)
+    for (s = 0; name && s < model->n_sets && strcmp(name, model->sets[s].wheel); ++s)
         ;
-    if (s == model->n_sets) {
-        wpm_message(msg, msg_size, "%s: no curves of wheel '%s'", model->name, name);
+    wpm_repr_text(name ? name : "", text, sizeof text);
+    if (!name || s == model->n_sets) {
+        append(msg, msg_size, &at, "%s: no curves of wheel %s; wheels: ", model->name, text);
+        append_wheels(model, msg, msg_size, &at);
         return SWTWPM_E_SELECTION;
     }
     for (w = 0; w < model->n_wheels; ++w)
@@ -748,50 +808,45 @@ int swtwpm_wheel_geometry(const swtwpm *model, const char *wheel, double geometr
             return 0;
         }
     wpm_message(msg, msg_size, "%s: no wheel geometry (header '# wheel_geometry:'), and this "
-                "needs wheel '%s''s radius, width and grousers; export the WPM CSV again with "
-                "this swtlab, or add the header (docs/wpm-csv.md)", model->name, name);
+                "needs wheel %s's radius, width and grousers; export the WPM CSV again with "
+                "this swtlab, or add the header (docs/wpm-csv.md)", model->name, text);
     return SWTWPM_E_SELECTION;
 }
 
 /* ---- the curve at a load ---- */
 
-/* _check_loads: 0, SWTWPM_WARN_LOAD_EXTRAPOLATED, or an error with the message */
-static int check_load(const wpm_quantity *q, double load, int flags, char *msg,
+/* 0, SWTWPM_WARN_LOAD_EXTRAPOLATED, or an error with the message (the kernel's _locate,
+ * the runtime's _outcome) */
+static int check_load(const wpm_quantity *q, int quantity, double load, int flags, char *msg,
                       size_t msg_size)
 {
-    char a[32], b[32], c[32], span[80];
+    char a[40], b[32], c[32], span[80];
+    const char *name = swtwpm_quantity_name(quantity);
     int L = q->n_loads;
-    if (!isfinite(load) || load <= 0) {
-        char shown[48] = "";
-        if (isnan(load))
-            strcpy(shown, "nan");
-        else if (!(load > 0)) { /* numpy's str of a float array: 5. for 5.0 */
-            wpm_repr(load, shown);
-            if (strlen(shown) > 2 && !strcmp(shown + strlen(shown) - 2, ".0"))
-                shown[strlen(shown) - 1] = '\0';
-        }
-        wpm_message(msg, msg_size, "loads must be finite and > 0 N, got [%s]", shown);
+    if (!(load > 0.0 && load < INFINITY)) {
+        wpm_repr(load, a);
+        wpm_message(msg, msg_size, "load_n=%s: the wheel load must be a finite number > 0 N", a);
         return SWTWPM_E_LOAD_RANGE;
     }
-    if (load >= q->loads[0] && load <= q->loads[L - 1])
+    if (q->loads[0] <= load && load <= q->loads[L - 1])
         return 0;
     if (L > 1)
         snprintf(span, sizeof span, "%s-%s N", wpm_g(q->loads[0], b), wpm_g(q->loads[L - 1], c));
     else
-        snprintf(span, sizeof span, "%s N only", wpm_g(q->loads[0], b));
+        snprintf(span, sizeof span, "%s N", wpm_g(q->loads[0], b));
     if (L < 2) {
-        wpm_message(msg, msg_size, "load %s N: one tested load (%s), nothing to interpolate "
-                    "from", wpm_g(load, a), span);
+        wpm_message(msg, msg_size, "load_n=%s N: %s was tested at %s only, nothing to "
+                    "interpolate from", wpm_g(load, a), name, span);
         return SWTWPM_E_LOAD_RANGE;
     }
     if (!(flags & SWTWPM_ALLOW_EXTRAPOLATION)) {
-        wpm_message(msg, msg_size, "load %s N outside the tested loads (%s); pass "
-                    "allow_extrapolation to extrapolate linearly from the two nearest loads",
-                    wpm_g(load, a), span);
+        wpm_message(msg, msg_size, "load_n=%s N is outside the tested loads (%s) of %s; pass "
+                    "allow_extrapolation=True to extrapolate linearly from the two nearest "
+                    "loads", wpm_g(load, a), span, name);
         return SWTWPM_E_LOAD_RANGE;
     }
-    wpm_message(msg, msg_size, "1 load(s) outside the tested loads (%s), e.g. %s N: "
-                "extrapolated linearly", span, wpm_g(load, a));
+    wpm_message(msg, msg_size, "1 load(s) outside the tested loads (%s) of %s, e.g. load_n=%s "
+                "N: extrapolated linearly", span, name, wpm_g(load, a));
     return SWTWPM_WARN_LOAD_EXTRAPOLATED;
 }
 
@@ -821,14 +876,25 @@ static void parameters(const wpm_quantity *q, double load, int outside, double *
         theta[j] = (1.0 - t) * q->at_tested[(hi - 1) * p + j] + t * q->at_tested[hi * p + j];
 }
 
+/* The checks of a query in the runtime's order (set and quantity, then the slip or target
+ * named `name` when not NULL, then the load) and the parameters at the load: 0 or
+ * SWTWPM_WARN_LOAD_EXTRAPOLATED, else an error code with the message. */
 static int prepare(const swtwpm *model, int set, int quantity, double load, int flags,
-                   double *theta, const wpm_quantity **out, char *msg, size_t msg_size)
+                   const char *name, double x, double *theta, const wpm_quantity **out,
+                   char *msg, size_t msg_size)
 {
     int code;
     const wpm_quantity *q = quantity_of(model, set, quantity, msg, msg_size, &code);
     if (!q)
         return code;
-    code = check_load(q, load, flags, msg, msg_size);
+    if (name && !(x - x == 0.0)) {
+        char a[40];
+        wpm_repr(x, a);
+        wpm_message(msg, msg_size, "%s=%s: %s queries need a finite number", name, a,
+                    swtwpm_quantity_name(quantity));
+        return SWTWPM_E_NOT_FINITE;
+    }
+    code = check_load(q, quantity, load, flags, msg, msg_size);
     if (code < 0)
         return code;
     parameters(q, load, code != 0, theta);
@@ -845,145 +911,238 @@ int swtwpm_value(const swtwpm *model, int set, int quantity, double load_n, doub
     if (!value)
         return SWTWPM_E_ARGUMENT;
     *value = NAN;
-    code = prepare(model, set, quantity, load_n, flags, theta, &q, msg, msg_size);
+    code = prepare(model, set, quantity, load_n, flags, "slip", slip, theta, &q, msg,
+                   msg_size);
     if (code < 0)
         return code;
-    if (!isfinite(slip)) {
-        char a[32];
-        wpm_message(msg, msg_size, "slip %s: slips must be finite numbers", wpm_g(slip, a));
-        return SWTWPM_E_NOT_FINITE;
-    }
     *value = horner(theta, q->degree + 1, slip);
-    if (theta[q->degree + 1] != 0 || theta[q->degree + 2] != 0)
-        *value = *value + (slip < 0 ? theta[q->degree + 1] + theta[q->degree + 2] * slip : 0.0);
+    if (slip < 0.0)
+        *value += theta[q->degree + 1] + theta[q->degree + 2] * slip;
     if (slip < q->lo || slip > q->hi) {
         char a[32], b[32];
-        wpm_message(msg, msg_size, "slip outside the range of %s [%s, %s]: extrapolated",
-                    swtwpm_quantity_name(quantity), wpm_g(q->lo, a), wpm_g(q->hi, b));
+        if (!code) /* the load's warning is the message when there are both */
+            wpm_message(msg, msg_size, "slip outside the range of %s [%s, %s]: extrapolated",
+                        swtwpm_quantity_name(quantity), wpm_g(q->lo, a), wpm_g(q->hi, b));
         code |= SWTWPM_WARN_SLIP_OUTSIDE;
     }
     return code;
 }
 
-/* ---- the inverse (wpm_export/inverse.py, one row) ---- */
+/* ---- the inverse (wpm_export/kernel.py: _root, _turning_points, _cuts, _find) ---- */
 
-#define MAX_POINTS 64
+#define ROW P_MAX /* longest parameter vector: room for the cuts of one side */
+
+static double horner_degree(const double *c, int degree, double x)
+{
+    double y = c[degree];
+    int i;
+    for (i = degree - 1; i >= 0; --i)
+        y = y * x + c[i];
+    return y;
+}
+
+/* Slip in [a, b] where sum c_i x^i - level crosses zero (fa, fb: the values at the ends, of
+ * opposite sign or one zero): safeguarded Newton from the secant point, bisection where a
+ * step would leave the bracket (Press et al. 2007, Numerical Recipes 3rd ed., sec. 9.4,
+ * rtsafe) */
+static double root(const double *c, int degree, double level, double a, double b, double fa,
+                   double fb)
+{
+    double secant, x;
+    int iteration;
+    if (fa == 0.0)
+        return a;
+    if (fb == 0.0)
+        return b;
+    secant = a - fa * (b - a) / (fb - fa);
+    x = (a < secant && secant < b) ? secant : 0.5 * (a + b);
+    for (iteration = 0; iteration < MAX_ITERATIONS; ++iteration) {
+        double f = c[degree], d = 0.0, newton, following, step;
+        int i;
+        for (i = degree - 1; i >= 0; --i) {
+            d = d * x + f;
+            f = f * x + c[i];
+        }
+        f -= level;
+        if (f == 0.0)
+            return x;
+        if ((f < 0.0) == (fa < 0.0)) {
+            a = x;
+            fa = f;
+        } else
+            b = x;
+        newton = d != 0.0 ? x - f / d : a - 1.0;
+        following = (a < newton && newton < b) ? newton : 0.5 * (a + b);
+        step = following - x;
+        x = following;
+        if (fabs(step) <= STEP_TOLERANCE * (1.0 + fabs(x - step)))
+            break;
+    }
+    return x;
+}
+
+/* simple real roots in (u, v) of c0 + c1 x + c2 x^2, increasing, into out; how many
+ * (the cancellation-free form: Press et al. 2007, sec. 5.6) */
+static int quadratic_roots(double c0, double c1, double c2, double u, double v, double *out)
+{
+    double disc, q, r0, r1, r[2];
+    int count = 0, j;
+    if (c2 == 0.0) {
+        if (c1 != 0.0 && u < -c0 / c1 && -c0 / c1 < v) {
+            out[0] = -c0 / c1;
+            count = 1;
+        }
+        return count;
+    }
+    disc = c1 * c1 - 4.0 * c2 * c0;
+    if (!(disc > 0.0))
+        return 0;
+    q = -0.5 * (c1 + copysign(sqrt(disc), c1));
+    r0 = q / c2;
+    r1 = c0 / q;
+    r[0] = r1 < r0 ? r1 : r0;
+    r[1] = r0 < r1 ? r1 : r0;
+    for (j = 0; j < 2; ++j)
+        if (u < r[j] && r[j] < v)
+            out[count++] = r[j];
+    return count;
+}
+
+/* Slips in (u, v) where the derivative of the degree-n polynomial c changes sign,
+ * increasing, into roots; how many. The k-th derivative is monotone between sign changes of
+ * the (k+1)-th: each level's roots bracket the next (the quadratic level in closed form). */
+static int turning_points(const double *c, int n, double u, double v, double *roots)
+{
+    double d[ROW][ROW], spare[ROW];
+    int k, i, j, count;
+    if (n < 2)
+        return 0;
+    for (i = 0; i <= n; ++i)
+        d[0][i] = c[i];
+    for (k = 1; k < n; ++k)
+        for (i = 0; i < n - k + 1; ++i)
+            d[k][i] = (i + 1) * d[k - 1][i + 1];
+    if (n == 2) { /* the derivative is linear */
+        double c0 = d[1][0], c1 = d[1][1];
+        if (c1 != 0.0 && u < -c0 / c1 && -c0 / c1 < v) {
+            roots[0] = -c0 / c1;
+            return 1;
+        }
+        return 0;
+    }
+    count = quadratic_roots(d[n - 2][0], d[n - 2][1], d[n - 2][2], u, v, roots);
+    for (k = n - 3; k > 0; --k) {
+        double x0 = u, f0 = horner_degree(d[k], n - k, u);
+        int found = 0;
+        for (j = 0; j < count + 1; ++j) {
+            double x1 = j < count ? roots[j] : v, f1 = horner_degree(d[k], n - k, x1);
+            if ((f0 < 0.0 && f1 > 0.0) || (f0 > 0.0 && f1 < 0.0))
+                spare[found++] = root(d[k], n - k, 0.0, x0, x1, f0, f1);
+            x0 = x1;
+            f0 = f1;
+        }
+        for (j = 0; j < found; ++j)
+            roots[j] = spare[j];
+        count = found;
+    }
+    return count;
+}
+
+/* the curve at one load cut into monotone pieces: slips xs and values fs of the cuts in
+ * slip order, the braked polynomial, the index of the cut that ends the braked side (-1
+ * without two sides) */
+typedef struct {
+    double braked[SWTWPM_MAX_DEGREE + 1], xs[2 * ROW], fs[2 * ROW];
+    int m, jump;
+} wpm_cuts;
+
+static void cut(const double *theta, int n, double lo, double hi, wpm_cuts *w)
+{
+    double roots[ROW];
+    int two = lo < 0.0 && 0.0 <= hi && (theta[n + 1] != 0.0 || theta[n + 2] != 0.0), side;
+    memcpy(w->braked, theta, (size_t)(n + 1) * sizeof *theta);
+    w->braked[0] += theta[n + 1];
+    w->braked[1] += theta[n + 2];
+    w->m = 0;
+    w->jump = -1;
+    for (side = 0; side < (two ? 2 : 1); ++side) {
+        int braked = (side == 0 && two) || (!two && hi < 0.0), count, j;
+        const double *poly = braked ? w->braked : theta;
+        double u = side == 0 ? lo : 0.0, v = two && side == 0 ? 0.0 : hi;
+        count = turning_points(poly, n, u, v, roots);
+        for (j = 0; j < count + 2; ++j) {
+            double x = j == 0 ? u : j == count + 1 ? v : roots[j - 1];
+            w->xs[w->m] = x;
+            w->fs[w->m] = horner_degree(poly, n, x);
+            ++w->m;
+        }
+        if (two && side == 0)
+            w->jump = w->m - 1;
+    }
+}
+
+/* slip, value and status of a target on the cut curve */
+static void find(const wpm_cuts *w, const double *theta, int n, double lo, double target,
+                 double *slip, double *value, int *status)
+{
+    double top = w->fs[0], bottom = w->fs[0];
+    int i;
+    for (i = 1; i < w->m; ++i) {
+        top = w->fs[i] > top ? w->fs[i] : top;
+        bottom = w->fs[i] < bottom ? w->fs[i] : bottom;
+    }
+    if (target > top) {
+        *slip = 1.0, *value = top, *status = SWTWPM_STATUS_ABOVE_MAX;
+        return;
+    }
+    if (target < bottom) {
+        *slip = NAN, *value = bottom, *status = SWTWPM_STATUS_BELOW_MIN;
+        return;
+    }
+    *value = target;
+    *status = SWTWPM_STATUS_OK;
+    if (target == w->fs[0]) {
+        *slip = lo;
+        return;
+    }
+    for (i = 0; i < w->m - 1; ++i) {
+        double f0 = w->fs[i], f1 = w->fs[i + 1];
+        double low = f0 < f1 ? f0 : f1, high = f0 < f1 ? f1 : f0;
+        if (low <= target && target <= high) {
+            const double *poly;
+            if (i == w->jump) {
+                *slip = 0.0;
+                if (low < target && target < high)
+                    *status = SWTWPM_STATUS_AT_STEP;
+                return;
+            }
+            poly = (w->jump >= 0 && i < w->jump) || (w->jump < 0 && w->xs[w->m - 1] < 0.0)
+                       ? w->braked : theta;
+            *slip = root(poly, n, target, w->xs[i], w->xs[i + 1], f0 - target, f1 - target);
+            return;
+        }
+    }
+    *slip = NAN, *status = SWTWPM_STATUS_BELOW_MIN; /* not reached: the pieces span it */
+}
 
 int swtwpm_slip_for(const swtwpm *model, int set, int quantity, double load_n, double target,
                     int flags, double *slip, double *value, int *status, char *msg,
                     size_t msg_size)
 {
-    double theta[P_MAX], braked[SWTWPM_MAX_DEGREE + 1], f[MAX_POINTS], d[MAX_POINTS];
-    double x_turn[MAX_POINTS], f_turn[MAX_POINTS], rise[MAX_POINTS], fall[MAX_POINTS];
-    double start, top, bottom, a, b, fa, fb, xt, ft, poly[SWTWPM_MAX_DEGREE + 1];
-    const double *polys[2];
+    double theta[P_MAX];
     const wpm_quantity *q;
-    const wpm_cells *cells;
-    int code, n, two, g, c, n_cells, first, jump, side_of_first, i;
+    wpm_cuts cuts;
+    int code;
     if (!slip || !value || !status)
         return SWTWPM_E_ARGUMENT;
     *slip = *value = NAN;
     *status = SWTWPM_STATUS_BELOW_MIN;
-    if (!quantity_of(model, set, quantity, msg, msg_size, &code))
-        return code;
-    if (!isfinite(target)) {
-        wpm_message(msg, msg_size, "targets must be finite numbers");
-        return SWTWPM_E_NOT_FINITE;
-    }
-    code = prepare(model, set, quantity, load_n, flags, theta, &q, msg, msg_size);
+    code = prepare(model, set, quantity, load_n, flags, "target", target, theta, &q, msg,
+                   msg_size);
     if (code < 0)
         return code;
-    n = q->degree + 1;
-    memcpy(braked, theta, (size_t)n * sizeof *braked);
-    braked[0] += theta[n];
-    braked[1] += theta[n + 1];
-    two = q->lo < 0 && 0 <= q->hi && (braked[0] != theta[0] || braked[1] != theta[1]);
-    cells = &q->cells[two];
-    polys[0] = two ? braked : (q->hi < 0 ? braked : theta);
-    polys[1] = theta;
-    n_cells = cells->points - 1;
-    jump = two ? cells->count0 : -1;
-    for (g = 0; g < cells->points; ++g) /* f = a @ power, d = a @ slope_power, per side */
-        f[g] = d[g] = 0.0;
-    for (i = 0; i < n; ++i) {
-        const double *power = cells->power + i * cells->points;
-        const double *slope_power = cells->slope_power + i * cells->points;
-        int split = two ? cells->count0 + 1 : cells->points;
-        double a0 = polys[0][i], a1 = polys[1][i];
-        for (g = 0; g < split; ++g) {
-            f[g] += a0 * power[g];
-            d[g] += a0 * slope_power[g];
-        }
-        for (g = split; g < cells->points; ++g) {
-            f[g] += a1 * power[g];
-            d[g] += a1 * slope_power[g];
-        }
-    }
-    for (c = 0; c < n_cells; ++c) {
-        x_turn[c] = f_turn[c] = NAN;
-        if (c != jump && ((d[c] > 0 && d[c + 1] < 0) || (d[c] < 0 && d[c + 1] > 0))) {
-            const double *poly_c = polys[two && c > cells->count0];
-            double derivative[SWTWPM_MAX_DEGREE];
-            for (i = 1; i < n; ++i)
-                derivative[i - 1] = poly_c[i] * i;
-            x_turn[c] = root(derivative, n - 1, cells->grid[c], cells->grid[c + 1]);
-            f_turn[c] = horner(poly_c, n, x_turn[c]);
-        }
-    }
-    start = f[0];
-    {
-        double up = np_fmax(f[1], f_turn[0]), down = np_fmin(f[1], f_turn[0]);
-        rise[0] = up;
-        fall[0] = down;
-        for (c = 1; c < n_cells; ++c) { /* running extremes, kept in registers */
-            up = np_max(up, np_fmax(f[c + 1], f_turn[c]));
-            down = np_min(down, np_fmin(f[c + 1], f_turn[c]));
-            rise[c] = up;
-            fall[c] = down;
-        }
-    }
-    top = np_max(start, rise[n_cells - 1]);
-    bottom = np_min(start, fall[n_cells - 1]);
-    *value = np_min(np_max(target, bottom), top);
-    if (target > top) {
-        *slip = 1.0;
-        *status = SWTWPM_STATUS_ABOVE_MAX;
-        return code;
-    }
-    if (target < bottom) {
-        *status = SWTWPM_STATUS_BELOW_MIN;
-        return code;
-    }
-    first = 0;
-    if (target >= start)
-        while (first < n_cells && rise[first] < target)
-            ++first;
-    else
-        while (first < n_cells && fall[first] > target)
-            ++first;
-    first = first < n_cells - 1 ? first : n_cells - 1;
-    a = cells->grid[first];
-    b = cells->grid[first + 1];
-    fa = f[first];
-    fb = f[first + 1];
-    xt = x_turn[first];
-    ft = f_turn[first];
-    if (isfinite(xt)) {
-        if (np_min(fa, ft) <= target && target <= np_max(fa, ft))
-            b = xt; /* the target is met before the turning point */
-        else
-            a = xt; /* ... or after it */
-    }
-    side_of_first = two && first > cells->count0;
-    memcpy(poly, polys[side_of_first], (size_t)n * sizeof *poly);
-    poly[0] -= target;
-    *slip = root(poly, n, a, b);
-    if (first == jump)
-        *slip = 0.0;
-    if (target == start)
-        *slip = q->lo;
-    *status = (first == jump && np_min(fa, fb) < target && target < np_max(fa, fb))
-                  ? SWTWPM_STATUS_AT_STEP : SWTWPM_STATUS_OK;
+    cut(theta, q->degree, q->lo, q->hi, &cuts);
+    find(&cuts, theta, q->degree, q->lo, target, slip, value, status);
     return code;
 }
 
@@ -992,19 +1151,22 @@ int swtwpm_slip_for(const swtwpm *model, int set, int quantity, double load_n, d
 int swtwpm_curve_at(const swtwpm *model, int set, int quantity, double load_n, int flags,
                     swtwpm_curve *curve, char *msg, size_t msg_size)
 {
-    double theta[P_MAX], base[GRID_POINTS], *y, sensitivity[GRID_POINTS];
+    double theta[P_MAX], t, y[2];
     const wpm_quantity *q;
-    int code, outside, L, p, k, g, i, j;
+    const double *c;
+    int code, outside, L, p, k, hi, i, j, r;
+    size_t pp;
     if (!curve)
         return SWTWPM_E_ARGUMENT;
     memset(curve, 0, sizeof *curve);
     curve->k95 = curve->scatter_sd = NAN;
-    code = prepare(model, set, quantity, load_n, flags, theta, &q, msg, msg_size);
+    code = prepare(model, set, quantity, load_n, flags, NULL, 0.0, theta, &q, msg, msg_size);
     if (code < 0)
         return code;
     outside = code != 0;
     L = q->n_loads;
     p = q->p;
+    pp = (size_t)p * p;
     curve->degree = q->degree;
     memcpy(curve->a, theta, (size_t)(q->degree + 1) * sizeof *theta);
     curve->step_below_zero = theta[q->degree + 1];
@@ -1016,83 +1178,34 @@ int swtwpm_curve_at(const swtwpm *model, int set, int quantity, double load_n, i
     curve->has_uncertainty = q->has_uncertainty;
     if (!curve->has_uncertainty)
         return code;
-    y = malloc((size_t)L * sizeof *y);
-    if (!y) {
-        wpm_message(msg, msg_size, "out of memory");
-        return SWTWPM_E_MEMORY;
-    }
-    for (g = 0; g < GRID_POINTS; ++g) {
-        for (k = 0; k < L; ++k)
-            y[k] = q->values[k * GRID_POINTS + g];
-        base[g] = across_load(q->loads, y, L, load_n, q->pchip, outside);
-    }
-    for (k = 0; k < L; ++k) { /* _propagate */
-        const wpm_row *row = q->tested[k];
-        int pk = row->degree + 3;
-        double mapped[P_MAX][P_MAX], cm[P_MAX][P_MAX];
-        for (g = 0; g < GRID_POINTS; ++g) {
-            int l;
-            for (l = 0; l < L; ++l)
-                y[l] = q->values[l * GRID_POINTS + g];
-            y[k] += q->delta;
-            sensitivity[g] = (across_load(q->loads, y, L, load_n, q->pchip, outside) - base[g])
-                             / q->delta;
-        }
-        memset(mapped, 0, sizeof mapped);
-        for (g = 0; g < GRID_POINTS; ++g) {
-            double s = q->grid[g], gradient[P_MAX], below = s < 0;
-            for (i = 0; i <= row->degree; ++i)
-                gradient[i] = pow(s, i);
-            gradient[row->degree + 1] = below;
-            gradient[row->degree + 2] = below * s;
-            for (i = 0; i < pk; ++i) {
-                double w = sensitivity[g] * gradient[i];
-                for (j = 0; j < p; ++j)
-                    mapped[i][j] += w * q->to_theta[g * p + j];
-            }
-        }
-        for (i = 0; i < pk; ++i) /* C_k mapped */
-            for (j = 0; j < p; ++j) {
-                double sum = 0;
-                int l;
-                for (l = 0; l < pk; ++l)
-                    sum += row->covariance[i][l] * mapped[l][j];
-                cm[i][j] = sum;
-            }
-        for (i = 0; i < p; ++i)
-            for (j = 0; j < p; ++j) {
-                double sum = 0;
-                int l;
-                for (l = 0; l < pk; ++l)
-                    sum += mapped[l][i] * cm[l][j];
-                curve->covariance[i][j] += sum;
-            }
-    }
-    if (L >= 3) { /* _interpolation_error: v v^T / 3, v the parameters of PCHIP - linear */
-        double v[P_MAX];
-        memset(v, 0, sizeof v);
-        for (g = 0; g < GRID_POINTS; ++g) {
-            double difference;
-            for (k = 0; k < L; ++k)
-                y[k] = q->values[k * GRID_POINTS + g];
-            difference = across_load(q->loads, y, L, load_n, 1, outside)
-                         - across_load(q->loads, y, L, load_n, 0, outside);
-            for (j = 0; j < p; ++j)
-                v[j] += difference * q->to_theta[g * p + j];
-        }
+    if (L == 1) { /* the kernel's _variance, as a matrix */
         for (i = 0; i < p; ++i)
             for (j = 0; j < p; ++j)
-                curve->covariance[i][j] += v[i] * v[j] / 3.0;
+                curve->covariance[i][j] = q->cov_ends[i * p + j];
+        curve->scatter_sd = q->tested[0]->scatter_sd > 0 ? q->tested[0]->scatter_sd : 0.0;
+        curve->k95 = q->tested[0]->k95 > 0 ? q->tested[0]->k95 : 0.0;
+        return code;
     }
-    for (k = 0; k < L; ++k)
-        y[k] = q->tested[k]->scatter_sd;
-    curve->scatter_sd = across_load(q->loads, y, L, load_n, 0, outside);
-    curve->scatter_sd = curve->scatter_sd > 0 ? curve->scatter_sd : 0.0;
-    for (k = 0; k < L; ++k)
-        y[k] = q->tested[k]->k95;
-    curve->k95 = across_load(q->loads, y, L, load_n, 0, outside);
-    curve->k95 = curve->k95 > 0 ? curve->k95 : 0.0;
-    free(y);
+    for (hi = 0; hi < L && q->loads[hi] < load_n; ++hi)
+        ;
+    k = (hi < 1 ? 1 : hi > L - 1 ? L - 1 : hi) - 1;
+    t = (load_n - q->loads[k]) / (q->loads[k + 1] - q->loads[k]);
+    for (i = 0; i < p; ++i)
+        for (j = 0; j < p; ++j) {
+            if (outside) /* linear: (1 - t)^2 D_k + t^2 D_k+1 */
+                curve->covariance[i][j] = (1.0 - t) * (1.0 - t) * q->cov_ends[k * pp + i * p + j]
+                                          + t * t * q->cov_ends[(k + 1) * pp + i * p + j];
+            else {
+                c = q->cov_inside + (size_t)k * 7 * pp + i * p + j;
+                curve->covariance[i][j] = c[6 * pp];
+                for (r = 5; r >= 0; --r)
+                    curve->covariance[i][j] = curve->covariance[i][j] * t + c[r * pp];
+            }
+        }
+    y[0] = (1.0 - t) * q->tested[k]->scatter_sd + t * q->tested[k + 1]->scatter_sd;
+    y[1] = (1.0 - t) * q->tested[k]->k95 + t * q->tested[k + 1]->k95;
+    curve->scatter_sd = y[0] > 0 ? y[0] : 0.0;
+    curve->k95 = y[1] > 0 ? y[1] : 0.0;
     return code;
 }
 
@@ -1143,8 +1256,12 @@ int swtwpm_value_band(const swtwpm *model, int set, int quantity, double load_n,
                       size_t msg_size)
 {
     swtwpm_curve curve;
-    int code = swtwpm_curve_at(model, set, quantity, load_n, flags, &curve, msg, msg_size);
-    int evaluated;
+    double theta[P_MAX];
+    const wpm_quantity *q;
+    int code = prepare(model, set, quantity, load_n, flags, "slip", slip, theta, &q, msg,
+                       msg_size);
+    if (code >= 0)
+        code = swtwpm_curve_at(model, set, quantity, load_n, flags, &curve, msg, msg_size);
     if (code < 0) {
         if (value)
             *value = NAN;
@@ -1154,12 +1271,7 @@ int swtwpm_value_band(const swtwpm *model, int set, int quantity, double load_n,
             *pred95 = NAN;
         return code;
     }
-    evaluated = swtwpm_curve_eval(&curve, slip, value, conf95, pred95);
-    if (evaluated == SWTWPM_E_NOT_FINITE) {
-        char a[32];
-        wpm_message(msg, msg_size, "slip %s: slips must be finite numbers", wpm_g(slip, a));
-    }
-    return evaluated < 0 ? evaluated : (code | evaluated);
+    return code | swtwpm_curve_eval(&curve, slip, value, conf95, pred95);
 }
 
 int swtwpm_value_many(const swtwpm *model, int set, int quantity, size_t n,

@@ -80,6 +80,45 @@ void wpm_repr(double x, char buffer[40])
         strcat(buffer, ".0");
 }
 
+/* Python's repr of a str (UTF-8): single quotes unless it holds ' and no ", backslash
+ * escapes of the quote, the backslash, \t \n \r and the other control characters (with
+ * U+0080 ... U+00A0 and U+00AD, which Python does not print either); cut to size */
+void wpm_repr_text(const char *s, char *buffer, size_t size)
+{
+    const unsigned char *c = (const unsigned char *)s;
+    char quote = strchr(s, '\'') && !strchr(s, '"') ? '"' : '\'';
+    size_t n = 0;
+    if (!size)
+        return;
+#define PUT(ch) (n + 1 < size ? (void)(buffer[n++] = (char)(ch)) : (void)0)
+    PUT(quote);
+    for (; *c; ++c) {
+        unsigned code = *c;
+        if (code == 0xC2 && c[1] >= 0x80 && (c[1] <= 0xA0 || c[1] == 0xAD))
+            code = *++c; /* U+0080 ... U+00A0, U+00AD */
+        else if (code >= 0x80) {
+            PUT(code);
+            continue;
+        }
+        if (code == '\\' || code == (unsigned char)quote) {
+            PUT('\\');
+            PUT(code);
+        } else if (code == '\t' || code == '\n' || code == '\r') {
+            PUT('\\');
+            PUT(code == '\t' ? 't' : code == '\n' ? 'n' : 'r');
+        } else if (code < 0x20 || code >= 0x7F) {
+            PUT('\\');
+            PUT('x');
+            PUT("0123456789abcdef"[code >> 4]);
+            PUT("0123456789abcdef"[code & 15]);
+        } else
+            PUT(code);
+    }
+    PUT(quote);
+#undef PUT
+    buffer[n] = '\0';
+}
+
 const char *swtwpm_quantity_name(int quantity)
 {
     return quantity >= 0 && quantity < SWTWPM_N_QUANTITIES ? QUANTITY_NAMES[quantity] : "?";

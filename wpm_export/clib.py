@@ -72,11 +72,13 @@ def library() -> ctypes.CDLL:
         "swtwpm_select": (i, [p, c, c, ctypes.c_longlong, c, sz]),
         "swtwpm_has_quantity": (i, [p, i, i]),
         "swtwpm_tested_loads": (i, [p, i, i, dp, i]),
+        "swtwpm_slip_range": (i, [p, i, i, dp, dp]),
         "swtwpm_wheel_geometry": (i, [p, c, dp, c, sz]),
         "swtwpm_value": (i, [p, i, i, d, d, i, dp, c, sz]),
         "swtwpm_slip_for": (i, [p, i, i, d, d, i, dp, dp, ip, c, sz]),
         "swtwpm_curve_at": (i, [p, i, i, d, i, ctypes.POINTER(Curve), c, sz]),
         "swtwpm_curve_eval": (i, [ctypes.POINTER(Curve), d, dp, dp, dp]),
+        "swtwpm_value_band": (i, [p, i, i, d, d, i, dp, dp, dp, c, sz]),
         "swtwpm_value_many": (i, [p, i, i, sz, dp, dp, i, dp, ip]),
         "swtwpm_slip_for_many": (i, [p, i, i, sz, dp, dp, i, dp, dp, ip, ip]),
     }
@@ -172,15 +174,17 @@ class CWheelPerformanceModule:
         return {k: (None if v != v else v) for k, v in zip(keys, out)}
 
     def _one_error(self, codes: np.ndarray, call) -> None:
-        """Raise for the first element with an error (its message from one scalar call),
-        warn once per warning kind."""
+        """Raise for the first element with an error (its message from one scalar call);
+        warn once when loads were extrapolated, with their count (as the runtime does)."""
         bad = np.flatnonzero(codes < 0)
         if bad.size:
             code, message = call(int(bad[0]))
             self._raise(code, message)
-        if np.any(codes & WARN_LOAD_EXTRAPOLATED):
-            _, message = call(int(np.flatnonzero(codes & WARN_LOAD_EXTRAPOLATED)[0]))
-            warnings.warn(message, LoadExtrapolationWarning, stacklevel=3)
+        extrapolated = np.flatnonzero(codes & WARN_LOAD_EXTRAPOLATED)
+        if extrapolated.size:
+            _, message = call(int(extrapolated[0]))  # "1 load(s) outside ...": one query's
+            warnings.warn(f"{extrapolated.size}{message[1:]}", LoadExtrapolationWarning,
+                          stacklevel=3)
 
     def value(self, quantity: str, slip, load_n, *, soil=None, wheel=None, multipass=None,
               allow_extrapolation: bool = False) -> np.ndarray:
@@ -202,8 +206,10 @@ class CWheelPerformanceModule:
 
         self._one_error(codes, call)
         if np.any(codes & WARN_SLIP_OUTSIDE):
-            warnings.warn(call(int(np.flatnonzero(codes & WARN_SLIP_OUTSIDE)[0]))[1],
-                          OutsideSlipRangeWarning, stacklevel=2)
+            lo, hi = ctypes.c_double(), ctypes.c_double()
+            self._lib.swtwpm_slip_range(self._model, k, q, ctypes.byref(lo), ctypes.byref(hi))
+            warnings.warn(f"slip outside the range of {quantity} [{lo.value:g}, {hi.value:g}]: "
+                          "extrapolated", OutsideSlipRangeWarning, stacklevel=2)
         return out.reshape(shape)
 
     def slip_for(self, quantity: str, target, load_n, *, soil=None, wheel=None,
@@ -247,15 +253,35 @@ class CWheelPerformanceModule:
             warnings.warn(message.value.decode(), LoadExtrapolationWarning, stacklevel=2)
         return out
 
-    def band(self, quantity: str, slip, load_n: float, **options
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(value, conf_half95, pred_half95)`` at the slips ``slip`` at one load."""
-        curve = self.curve(quantity, load_n, **options)
-        s = np.asarray(slip, dtype=float)
+    def band(self, quantity: str, slip, load_n, *, soil=None, wheel=None, multipass=None,
+             allow_extrapolation: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(value, conf_half95, pred_half95)`` at ``slip`` and ``load_n`` (broadcast
+        together; the curve with its covariance computed once per run of equal loads)."""
+        k, q = self.select(soil, wheel, multipass), QUANTITIES.index(quantity)
+        flags = ALLOW_EXTRAPOLATION if allow_extrapolation else 0
+        s, w = (np.ascontiguousarray(x, dtype=float).ravel() for x in
+                np.broadcast_arrays(np.asarray(slip, float), np.asarray(load_n, float)))
+        shape = np.broadcast_shapes(np.shape(slip), np.shape(load_n))
         out = np.empty((3, s.size))
+        curve, message = Curve(), ctypes.create_string_buffer(MESSAGE_SIZE)
         value, conf, pred = ctypes.c_double(), ctypes.c_double(), ctypes.c_double()
-        for i, x in enumerate(s.flat):
-            self._lib.swtwpm_curve_eval(ctypes.byref(curve), x, ctypes.byref(value),
+        last, code, extrapolated, warning = None, 0, 0, ""
+        for i in range(s.size):
+            if not np.isfinite(s[i]) or w[i] != last:  # the checks, in the runtime's order
+                code = self._lib.swtwpm_value_band(
+                    self._model, k, q, w[i], s[i], flags, ctypes.byref(value),
+                    ctypes.byref(conf), ctypes.byref(pred), message, MESSAGE_SIZE)
+                if code < 0:
+                    self._raise(code, message.value.decode())
+                if code & WARN_LOAD_EXTRAPOLATED and not warning:
+                    warning = message.value.decode()
+                self._lib.swtwpm_curve_at(self._model, k, q, w[i], flags, ctypes.byref(curve),
+                                          None, 0)
+                last = w[i]
+            extrapolated += bool(code & WARN_LOAD_EXTRAPOLATED)
+            self._lib.swtwpm_curve_eval(ctypes.byref(curve), s[i], ctypes.byref(value),
                                         ctypes.byref(conf), ctypes.byref(pred))
             out[:, i] = value.value, conf.value, pred.value
-        return tuple(row.reshape(s.shape) for row in out)
+        if extrapolated:
+            warnings.warn(f"{extrapolated}{warning[1:]}", LoadExtrapolationWarning, stacklevel=2)
+        return tuple(row.reshape(shape) for row in out)
