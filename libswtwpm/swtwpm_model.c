@@ -622,19 +622,25 @@ static void append(char *out, size_t size, size_t *at, const char *format, ...)
     *at = n < 0 ? *at : *at + (size_t)n < size ? *at + (size_t)n : size - 1;
 }
 
-/* "soil='a', wheel='b', multipass=0" (runtime._selection_text; NULL / negative: None) */
+/* "soil='a', wheel='b', multipass=0" (runtime._selection_text): the arguments given, NULL /
+   negative ones left out */
 static void append_selection(char *out, size_t size, size_t *at, const char *soil,
                              const char *wheel, long long multipass)
 {
-    char text[2][1024];
-    wpm_repr_text(soil ? soil : "", text[0], sizeof text[0]);
-    wpm_repr_text(wheel ? wheel : "", text[1], sizeof text[1]);
-    append(out, size, at, "soil=%s, wheel=%s, multipass=", soil ? text[0] : "None",
-           wheel ? text[1] : "None");
-    if (multipass < 0)
-        append(out, size, at, "None");
-    else
-        append(out, size, at, "%lld", multipass);
+    char text[1024];
+    const char *sep = "";
+    if (soil) {
+        wpm_repr_text(soil, text, sizeof text);
+        append(out, size, at, "soil=%s", text);
+        sep = ", ";
+    }
+    if (wheel) {
+        wpm_repr_text(wheel, text, sizeof text);
+        append(out, size, at, "%swheel=%s", sep, text);
+        sep = ", ";
+    }
+    if (multipass >= 0)
+        append(out, size, at, "%smultipass=%lld", sep, multipass);
 }
 
 static int matches(const wpm_set *set, const char *soil, const char *wheel,
