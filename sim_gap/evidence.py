@@ -20,10 +20,11 @@ Occam factor (a parameter the data pin down costs ``log(prior width / posterior 
 is what lets a one-effect explanation beat a two-effect one that fits as well.
 
 ``tau`` is integrated over a log-uniform grid (a scale prior, Jeffreys 1961): the base model
-may be right to a quarter of the repeatability floor or wrong by sixteen times it, about 16 %
-of the load in drawbar pull, as large as the largest candidate effect (:data:`TAU_GRID`); a
-smooth error of that size, common to every source and level, is discrepancy, not evidence
-for an effect. The discrepancy is *shared*: one function of slip and load for every
+may be right to a quarter of the repeatability floor or wrong by as much as the quantity
+itself: 128 floors is about the wheel load in drawbar pull at the loads of a lab campaign
+(the floor is 1 % of the load + 0.3 N), and no model misses a force by more than the load it
+carries (:data:`TAU_GRID`). A smooth error common to every source and level is discrepancy,
+not evidence for an effect, whatever its size. The discrepancy is *shared*: one function of slip and load for every
 source, multipass level and gravity level, so an error common to sibling sources (a smooth
 and a lugged wheel on one soil) cancels in their contrast, which only an effect (or the
 hypothesis "outside the candidates", :func:`log_evidence`'s ``outside``) can carry.
@@ -47,7 +48,7 @@ from sim_gap.vocabulary import model_error_floor
 LENGTH_SLIP = 0.3
 LENGTH_LOG_LOAD = 0.5
 #: the shared discrepancy's amplitude in units of the repeatability floor (log-uniform)
-TAU_GRID = np.geomspace(0.25, 16.0, 7)
+TAU_GRID = np.geomspace(0.25, 128.0, 10)
 #: prior standard deviation of a profiled offset (a relative sinkage's unknown zero), m
 OFFSET_PRIOR_SD_M = 0.1
 
