@@ -53,7 +53,7 @@ QUANTITIES: dict[str, str] = {
 
 #: terms of a quantity's uncertainty budget (``run_results.uncertainty_budget``)
 UNCERTAINTY_TERMS = ("statistical", "zero_drift", "calibration", "quantisation",
-                     "phase_sampling", "clock")
+                     "phase_sampling", "clock", "timing")
 #: results-table columns of a quantity's budget, ``<q>_<name>`` (docs/results.md)
 BUDGET_COLUMNS = ("u", "u95", "k", "dof", "correction", *(f"u_{t}" for t in UNCERTAINTY_TERMS))
 
