@@ -2,8 +2,10 @@
 
 A rate over the window is its displacement over the window's time: ``rate = (x_1 - x_0) /
 (t_1 - t_0)`` from the first and last native samples of the encoder inside the window
-(the angle, the sled position), or, where the source logs a rate instead of a position, the
-time integral of its native samples (trapezoids) over the same span. Slip is the spec's
+(the angle, the sled position), or, where the source logs the rate itself (a channel map's
+``wheel_surface_speed_mps``, ``sled_velocity_mps``; ingest takes it over a derivative too),
+the time integral of its native samples (trapezoids) over the same span, i.e. their
+time-weighted mean. Slip is the spec's
 definition applied to those two rates, ``s = (r w - v)/(r w)`` driving (``r w >= v``) and
 ``(r w - v)/v`` skid, ``r`` the wheel radius without grousers (``ingest.derive.slip``). The
 mean of per-sample ratios ``1 - v/(r w)`` of quantised finite differences is not used: the
@@ -101,19 +103,20 @@ def _edges(t_s: np.ndarray, start_s: float, end_s: float, batches: int) -> np.nd
 
 
 def _samples(run, key: str, start_s: float, end_s: float):
-    """``(t_s, x, source, rate_step)``: the window's native positions (``rate_step`` None), or
-    the integral of a logged rate; None without either."""
+    """``(t_s, x, source, logged)``: the integral of a rate the source logs (the lab's own
+    rate measurement, which ingest also takes over a derivative) with ``logged = (step,
+    rate samples)``, else the window's native positions (``logged`` None); None without
+    either."""
     position, logged = SOURCES[key]
-    samples = channel_samples(run, position, start_s, end_s)
-    if samples is not None and samples[0].size >= 2:
-        return samples[0], samples[1], position, None
     for column, per_radius in logged:
         samples = channel_samples(run, column, start_s, end_s)
         if samples is not None and samples[0].size >= 2:
             t, y = samples
             y = y / run.metadata.wheel.radius_m if per_radius else y
-            step = quantisation_step(y)
-            return t, cumulative_trapezoid(y, t, initial=0.0), column, (step, y)
+            return t, cumulative_trapezoid(y, t, initial=0.0), column, (quantisation_step(y), y)
+    samples = channel_samples(run, position, start_s, end_s)
+    if samples is not None and samples[0].size >= 2:
+        return samples[0], samples[1], position, None
     return None
 
 

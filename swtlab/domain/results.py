@@ -58,6 +58,24 @@ UNCERTAINTY_TERMS = ("statistical", "zero_drift", "calibration", "quantisation",
 BUDGET_COLUMNS = ("u", "u95", "k", "dof", "correction", *(f"u_{t}" for t in UNCERTAINTY_TERMS))
 
 
+#: results-table column: what the run's budgets could not measure (docs/results.md)
+NOT_MEASURED = "not_measured"
+
+
+def not_measured_text(items) -> str:
+    """The ``not_measured`` column of a run: its budgets' ``not_measured`` items, each once,
+    sorted, ``'; '``-separated."""
+    return "; ".join(sorted(set(items)))
+
+
+def not_measured_heads(text) -> list[str]:
+    """The items of a ``not_measured`` cell without their explanations (the text before
+    ``' ('``), for a summary."""
+    if not isinstance(text, str) or not text:
+        return []
+    return sorted({item.split(" (")[0] for item in text.split("; ")})
+
+
 def budget_columns(quantity: str, budget: dict) -> dict:
     """A budget (``QuantityBudget.to_dict()``, or as stored) as results-table columns."""
     return {f"{quantity}_{name}": budget.get(name) for name in BUDGET_COLUMNS}
