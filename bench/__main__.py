@@ -2,7 +2,8 @@
 
 Each ``bench/bench_<name>.py`` has ``main(quick: bool) -> dict`` that prints
 its own table and returns its numbers; the numbers of a run are written to
-``bench/results/<name>.json`` for comparison between commits.
+``bench/results/<name>.json`` for comparison between commits. ``--markdown``: a benchmark
+with ``markdown(numbers) -> str`` also writes ``docs/validation/<name>.md``.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import pkgutil
 from pathlib import Path
 
 import bench
+from swtlab.atomic import write_atomically
 
 
 def main() -> None:
@@ -22,6 +24,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__)
     parser.add_argument("names", nargs="*", help=f"benchmarks to run (default: all of {names})")
     parser.add_argument("--quick", action="store_true", help="smaller inputs, for a smoke run")
+    parser.add_argument("--markdown", action="store_true",
+                        help="also write docs/validation/<name>.md where the benchmark can")
     args = parser.parse_args()
     unknown = sorted(set(args.names) - set(names))
     if unknown:
@@ -30,8 +34,14 @@ def main() -> None:
     out.mkdir(exist_ok=True)
     for name in args.names or names:
         print(f"== bench {name}")
-        numbers = importlib.import_module(f"bench.bench_{name}").main(quick=args.quick)
+        module = importlib.import_module(f"bench.bench_{name}")
+        numbers = module.main(quick=args.quick)
         (out / f"{name}.json").write_text(json.dumps(numbers, indent=2, default=float))
+        if args.markdown and hasattr(module, "markdown"):
+            page = Path(__file__).parents[1] / "docs" / "validation" / f"{name}.md"
+            page.parent.mkdir(exist_ok=True)
+            write_atomically(page, module.markdown(numbers))
+            print(f"written {page}")
 
 
 if __name__ == "__main__":
