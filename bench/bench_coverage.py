@@ -19,8 +19,9 @@ absent) against the authors' own slips (their 70-75 s means, ``smooth_runs.csv``
 difference, ``z = (ours - authors)/u`` and the share inside ``u95``. Their value is itself a
 5 s estimate over another window of a drive whose speed wanders, so this is a check of
 agreement, not of coverage. 5-7 min per generator of 2,000 runs on one core; ``--quick``: 60
-runs of the first seed each. ``--markdown`` (``python -m bench coverage --markdown``) writes
-the tables to docs/validation/coverage.md.
+runs of the first seed each (seen for this code before the full run, as a smoke test;
+nothing was changed after it). ``--markdown`` (``python -m bench coverage --markdown``)
+writes the tables to docs/validation/coverage.md.
 
 Seeds used while tuning the budget: virtual 101, 102; second rig 201 (for the opt-in
 ``settling_overshoot`` detector and for the whole-pitch batch means of the statistical
@@ -123,8 +124,8 @@ def _markdown_table(rows: dict, columns: list[str], digits: int = 3) -> list[str
     header = ["quantity", *columns]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for name, row in rows.items():
-        cells = [f"{row[c]:.{digits}f}" if isinstance(row.get(c), float)
-                 and np.isfinite(row[c]) else str(row.get(c, "")) for c in columns]
+        cells = [str(int(row[c])) if c == "runs" else f"{row[c]:.{digits}f}"
+                 if isinstance(row.get(c), float) and np.isfinite(row[c]) else "" for c in columns]
         lines.append("| " + " | ".join([name, *cells]) + " |")
     return lines
 
