@@ -5,7 +5,9 @@ second rig 201. These seeds are other ones.
 
 - virtual testbed (in-family: the estimators were built beside it);
 - second rig (independent signal model: underdamped transients, shark-fin grouser load,
-  drift since a zeroing minutes before the run, gain errors, drive speed ripple).
+  drift since a zeroing minutes before the run, gain errors, drive speed ripple);
+- the second rig's low-speed coarse-encoder mode (a 14-bit wheel encoder and the sled at
+  500 Hz, 5-20 mm/s: slip, speeds from displacements of a count or none a sample).
 
 With 60 runs a true 95 % coverage reads 90-100 % (2 binomial sd); the bounds below allow
 that, and the printout gives the coverage and the spread of ``(mean - truth)/u``.
@@ -23,8 +25,8 @@ REQUIRED = ("dp_n", "torque_nm", "wheel_load_n", "slip", "sinkage_m", "resistanc
             "travel_velocity_mps")
 
 
-@pytest.fixture(scope="module", params=[("virtual", 131), ("second", 231)],
-                ids=["virtual", "second_rig"])
+@pytest.fixture(scope="module", params=[("virtual", 131), ("second", 231), ("low_speed", 331)],
+                ids=["virtual", "second_rig", "low_speed"])
 def table(request, tmp_path_factory):
     generator, seed = request.param
     scores = run_coverage(tmp_path_factory.mktemp(generator), generator, RUNS, seed)
