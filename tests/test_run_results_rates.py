@@ -1,12 +1,12 @@
 """Wheel speed, travel velocity and slip from the window's displacements (run_results.rates)
-against synthetic encoders whose truth is set by hand, and the second rig's low-speed
-coarse-encoder runs through the whole chain (independent of the estimators).
+against synthetic encoders whose truth is set by hand (the second rig's low-speed runs
+through the whole chain: tests/test_uncertainty_coverage.py, bench coverage).
 
 The synthetic encoders are the issue's case: a 14-bit wheel encoder and a 10 um sled encoder
-at 500 Hz, sled at 10.3 mm/s (not a whole number of sled steps a sample), set slip 0.05, so the wheel turns about half a count per sample.
-The mean of per-sample ratios ``1 - v/(r w)`` of finite differences is biased there
-(Jensen's inequality); the ratio of the displacements is not, and its quantisation term (two
-end readings, ``q/(sqrt(6) T)``) holds what is left.
+at 500 Hz, sled at 10.3 mm/s (not a whole number of sled steps a sample), set slip 0.05, so
+the wheel turns about half a count per sample. The mean of per-sample ratios ``1 - v/(r w)``
+of finite differences is biased there (Jensen's inequality); the ratio of the displacements
+is not, and its quantisation term (two end readings, ``q/(sqrt(6) T)``) holds what is left.
 """
 
 from __future__ import annotations
