@@ -83,6 +83,39 @@ def cmu_slips(root: Path = CMU_ROOT) -> pd.DataFrame:
                         inside_u95=table["difference"].abs() <= table["u95"])
 
 
+def summary(generator: str, seeds, runs: int, scores: list[pd.DataFrame],
+            seconds: float) -> dict:
+    """Print and return one generator's tables from its seeds' :func:`run_coverage` rows."""
+    pooled = pd.concat(scores, ignore_index=True)
+    table = coverage(pooled)
+    modes = _covered_by(pooled, "mode", table.index)
+    per_seed = _covered_by(pooled, "seed", table.index)
+    print(f"{generator} (seeds {seeds[0]}-{seeds[-1]}, {len(seeds)} x {runs} runs, "
+          f"{seconds:.0f} s):")
+    print(table.round(3).to_string())
+    print(f"{generator}, coverage by run mode:\n{modes.round(3).to_string()}")
+    print(f"{generator}, coverage by seed:\n{per_seed.round(3).to_string()}")
+    return {"seeds": list(seeds), "runs_per_seed": runs, "seconds": seconds,
+            "by_quantity": table.round(4).to_dict(orient="index"),
+            "by_mode": modes.round(4).to_dict(orient="index"),
+            "by_seed": per_seed.round(4).to_dict(orient="index")}
+
+
+def cmu_summary() -> dict | None:
+    """Print and return the CMU comparison (:func:`cmu_slips`); None without the data."""
+    cmu = cmu_slips()
+    if cmu.empty:
+        return None
+    summary = {"logs": len(cmu), "inside_u95": float(cmu["inside_u95"].mean()),
+               "z_std": float(cmu["z"].std()), "z_median": float(cmu["z"].median()),
+               "abs_difference_median": float(cmu["difference"].abs().median()),
+               "abs_difference_max": float(cmu["difference"].abs().max())}
+    print("CMU logs, slip against the authors' (their 70-75 s means):")
+    print(cmu.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    print({k: round(v, 5) for k, v in summary.items()})
+    return {"summary": summary, "logs": cmu.round(6).to_dict(orient="records")}
+
+
 def main(quick: bool = False) -> dict:
     runs = QUICK_RUNS if quick else RUNS
     out = {}
@@ -93,30 +126,10 @@ def main(quick: bool = False) -> dict:
         for seed in seeds:
             with tempfile.TemporaryDirectory() as tmp:
                 scores.append(run_coverage(tmp, generator, runs, seed).assign(seed=seed))
-        seconds = time.perf_counter() - t0
-        pooled = pd.concat(scores, ignore_index=True)
-        table = coverage(pooled)
-        modes = _covered_by(pooled, "mode", table.index)
-        per_seed = _covered_by(pooled, "seed", table.index)
-        print(f"{generator} (seeds {seeds[0]}-{seeds[-1]}, {len(seeds)} x {runs} runs, "
-              f"{seconds:.0f} s):")
-        print(table.round(3).to_string())
-        print(f"{generator}, coverage by run mode:\n{modes.round(3).to_string()}")
-        print(f"{generator}, coverage by seed:\n{per_seed.round(3).to_string()}")
-        out[generator] = {"seeds": list(seeds), "runs_per_seed": runs, "seconds": seconds,
-                          "by_quantity": table.round(4).to_dict(orient="index"),
-                          "by_mode": modes.round(4).to_dict(orient="index"),
-                          "by_seed": per_seed.round(4).to_dict(orient="index")}
-    cmu = cmu_slips()
-    if len(cmu):
-        summary = {"logs": len(cmu), "inside_u95": float(cmu["inside_u95"].mean()),
-                   "z_std": float(cmu["z"].std()), "z_median": float(cmu["z"].median()),
-                   "abs_difference_median": float(cmu["difference"].abs().median()),
-                   "abs_difference_max": float(cmu["difference"].abs().max())}
-        print("CMU logs, slip against the authors' (their 70-75 s means):")
-        print(cmu.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-        print({k: round(v, 5) for k, v in summary.items()})
-        out["cmu"] = {"summary": summary, "logs": cmu.round(6).to_dict(orient="records")}
+        out[generator] = summary(generator, seeds, runs, scores, time.perf_counter() - t0)
+    cmu = cmu_summary()
+    if cmu is not None:
+        out["cmu"] = cmu
     return out
 
 
