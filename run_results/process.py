@@ -7,7 +7,8 @@ Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correctio
 steered runs also the side force ``fy`` and the slip angle (logged channel, else the
 set steering angle). Plausibility and sensor health (``plausibility``: saturation, dead
 channels, SE of 0, negative load or sinkage, set against measured load, metadata ranges,
-dig-in) are checked on the calibrated, zeroed channels and flag the run. Single-channel
+dig-in) are checked on the calibrated, zeroed channels and flag the run. Wheel speed, travel
+velocity and slip come from the window's displacements (``rates``). Single-channel
 quantities come from the native samples, the means of resistance and sinkage from the
 channels' native means (``native``). Given the run's track photos as measured
 (``image_slip``: the slip read from the grouser marks by ``softflow.track_run``, which the
@@ -160,7 +161,7 @@ def _rates(run, window, series, lo: int, hi: int) -> dict:
         found = window_slip(out["wheel_omega_radps"], out["travel_velocity_mps"],
                             run.metadata.wheel.radius_m, spread("slip"))
         if found is not None:
-            out["slip"] = found[0]
+            out["slip"] = found
     return out
 
 

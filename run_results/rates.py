@@ -163,9 +163,9 @@ def slip_sensitivities(surface_mps: float, velocity_mps: float) -> tuple[float, 
 
 
 def window_slip(omega: RateEstimate, velocity: RateEstimate, radius_m: float,
-                spread: float) -> tuple[RateEstimate, tuple[float, float]] | None:
-    """The spec slip of the window rates and its terms (module doc), with the sensitivities
-    ``(ds/dw, ds/dv)``; None where both speeds are 0 (slip undefined)."""
+                spread: float) -> RateEstimate | None:
+    """The spec slip of the window rates and its terms (module doc); None where both speeds
+    are 0 (slip undefined)."""
     surface, v = radius_m * omega.stats.mean, velocity.stats.mean
     value = float(spec_slip(np.array([surface]), np.array([v]), 0.0)[0])
     if not math.isfinite(value):
@@ -180,5 +180,5 @@ def window_slip(omega: RateEstimate, velocity: RateEstimate, radius_m: float,
     timing = math.hypot(c_w * omega.timing_u, c_v * velocity.timing_u)
     n = min(omega.stats.n, velocity.stats.n)
     stats = QuantityStats(mean=value, std=spread, se=se, n=n, n_eff=_n_eff(dof, n), unit="1")
-    return (RateEstimate(stats, dof, quantisation, timing, residuals,
-                         f"{omega.source}, {velocity.source}"), (c_w, c_v))
+    return RateEstimate(stats, dof, quantisation, timing, residuals,
+                        f"{omega.source}, {velocity.source}")

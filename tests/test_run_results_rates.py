@@ -47,7 +47,7 @@ def _run(rng, jitter_s: float = 0.0, duration_s: float = 20.0, slip: float = SLI
 def _slip(run, start_s=0.5, end_s=19.5):
     omega = window_rate(run, "wheel_omega_radps", start_s, end_s, float("nan"))
     v = window_rate(run, "travel_velocity_mps", start_s, end_s, float("nan"))
-    return window_slip(omega, v, RADIUS_M, float("nan"))[0], omega, v
+    return window_slip(omega, v, RADIUS_M, float("nan")), omega, v
 
 
 def test_the_mean_of_per_sample_ratios_is_biased_where_the_displacements_are_not():
