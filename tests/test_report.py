@@ -322,6 +322,9 @@ def test_run_table_shows_each_runs_stored_standard_uncertainty(small):
                                ("u(slip) [%]", "slip", 100.0)):
         assert float(cells[columns.index(column)]) == pytest.approx(
             stored.loc["L180_MP0_SC_s+020", f"{key}_u"] * scale, rel=0.05)  # 2 digits shown
+    # beside u( ): what the budgets left out (the sample has no replicates, no calibration keys)
+    note = re.search(r"Not measured, so not in u\( \): (.*?)\.", unescape(text)).group(1)
+    assert "run-to-run repeatability (" in note and "calibration (" in note
 
 
 def test_hidden_error_bars_get_a_note_and_repeatability_follows_the_run_table(small):
