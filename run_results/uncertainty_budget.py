@@ -44,11 +44,12 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
   ``exp(-2 pi^2 s^2 / q^2)`` for samples spread by ``s`` (dithered by their own noise: the
   first harmonic of the quantiser's mean error for Gaussian input, Widrow, Kollar & Liu 1996,
   IEEE Trans. Instrum. Meas. 45(2) 353; ``run_results.rest_readings.quantisation_u``); load
-  cells and the suspension arm. The rates: the encoders' step at the window's two ends,
-  ``q/(sqrt(6) T)`` (``run_results.rates``), propagated to slip.
+  cells and the suspension arm. The rates: the encoders' step in the window's two end
+  values (local lines), ``(q/sqrt(12)) sqrt(h_0 + h_B) / T`` with ``h`` their leverages
+  (``run_results.rates``), propagated to slip.
 - ``timing``: the rates' time stamps, scattered by ``sigma_t`` measured from the stream's
-  intervals, at the window's two ends: ``|rate| sqrt(2) sigma_t / T`` (``run_results.rates``),
-  propagated to slip.
+  intervals, in the same end values: ``|rate| sigma_t sqrt(h_0 + h_B) / T``
+  (``run_results.rates``), propagated to slip.
 - ``phase_sampling``: a sensor sampling a sharp-edged grouser wave only ``m`` times a period
   sees few of its phases; the rectangle rule over a period errs by at most ``drop / (2 m)``
   for a jump ``drop`` (the largest step between adjacent phase bins of the waveform), a

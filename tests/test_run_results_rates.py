@@ -6,7 +6,8 @@ The synthetic encoders are the issue's case: a 14-bit wheel encoder and a 10 um 
 at 500 Hz, sled at 10.3 mm/s (not a whole number of sled steps a sample), set slip 0.05, so
 the wheel turns about half a count per sample. The mean of per-sample ratios ``1 - v/(r w)``
 of finite differences is biased there (Jensen's inequality); the ratio of the displacements
-is not, and its quantisation term (two end readings, ``q/(sqrt(6) T)``) holds what is left.
+is not, and its quantisation term (the window's end values from local lines) bounds what
+is left.
 """
 
 from __future__ import annotations
@@ -53,7 +54,7 @@ def _slip(run, start_s=0.5, end_s=19.5):
 def test_the_mean_of_per_sample_ratios_is_biased_where_the_displacements_are_not():
     """Per-sample ratios of 0-1 count differences, smoothed over 20 ms: biased low by about
     ``(1 - s) var_rel(r w)`` (measured 0.0428 for 0.05; 0.0495 over 50 ms); the
-    displacements give 0.05 to within their quantisation (u about 7e-5)."""
+    displacements give 0.05 to within their quantisation."""
     rng = np.random.default_rng(1)
     run, _ = _run(rng)
     t = run.streams["/wheel/encoder"]["t_s"].to_numpy()
@@ -69,45 +70,63 @@ def test_the_mean_of_per_sample_ratios_is_biased_where_the_displacements_are_not
     assert abs(s.stats.mean - SLIP) < 3e-4
 
 
-def test_the_quantisation_term_holds_the_end_readings_and_covers():
+def test_the_quantisation_term_bounds_the_end_values_error():
     """200 runs of random encoder phase and window length (a whole number of samples of a
-    fixed rate would fix the counts' fractional part over the window): the slip's error
-    spreads as its quantisation term says (two uniform end readings per encoder: z spread 1
-    within sampling; measured 1.01), and ``+- 1.96`` times it covers 93-99 % (a triangular
-    error inside 1.96 sigma: 96 %; the statistical term, the batches' telescoped ends, adds
-    to the budget's interval)."""
+    fixed rate would fix the counts' fractional part over the window): no bias (mean z near
+    0), and the quantisation term, which takes the readings' errors as independent, bounds
+    the error of the end lines' values: a moving encoder's readings err by a sawtooth, whose
+    mean over the fit's counts errs less (z spread measured 0.33); the budget's interval
+    (quantisation and statistical terms) covers every run."""
     rng = np.random.default_rng(2)
     z, covered = [], []
     for _ in range(200):
         run, _ = _run(rng)
         s, _, _ = _slip(run, end_s=rng.uniform(10.0, 19.5))
         assert s.timing_u < 1e-12
-        z.append((s.stats.mean - SLIP) / s.quantisation_u)
-        covered.append(abs(s.stats.mean - SLIP) <= 1.96 * s.quantisation_u)
-    assert 0.85 < np.std(z) < 1.15
-    assert 0.93 <= np.mean(covered) <= 0.99
+        error = s.stats.mean - SLIP
+        z.append(error / s.quantisation_u)
+        covered.append(abs(error) <= 1.96 * math.hypot(s.quantisation_u, s.stats.se))
+    assert abs(np.mean(z)) < 0.1
+    assert 0.1 < np.std(z) < 1.0
+    assert np.mean(covered) >= 0.97
+
+
+def _leverage(t: np.ndarray, at: float) -> float:
+    """``[1, at] (X^T X)^-1 [1, at]^T`` of a straight-line fit to the times ``t``."""
+    design = np.column_stack([np.ones(t.size), t])
+    point = np.array([1.0, at])
+    return float(point @ np.linalg.inv(design.T @ design) @ point)
+
+
+def _end_leverages(t: np.ndarray, start_s: float, end_s: float) -> float:
+    half = (end_s - start_s) / 20 / 2
+    first = t[(t >= start_s) & (t < start_s + half)]
+    last = t[(t > end_s - half) & (t <= end_s)]
+    return _leverage(first, start_s) + _leverage(last, end_s)
 
 
 def test_quantisation_of_a_window_rate_by_hand():
-    """``q/(sqrt(6) T)`` with the sled's 10 um step over the window's first-to-last samples."""
+    """``(q/sqrt(12)) sqrt(h_0 + h_B) / T`` with the sled's 10 um step, ``h`` the leverages of
+    the window's two end lines (half a span of samples each, one-sided) at the window's ends,
+    from the design matrix."""
     run, _ = _run(np.random.default_rng(3))
     v = window_rate(run, "travel_velocity_mps", 2.0, 12.0, 0.0)
     t = run.streams["/sled/encoder"]["t_s"].to_numpy()
-    span = t[t <= 12.0][-1] - t[t >= 2.0][0]
-    assert v.quantisation_u == pytest.approx(SLED_STEP / math.sqrt(6) / span, rel=1e-3)
+    expected = SLED_STEP / math.sqrt(12) * math.sqrt(_end_leverages(t, 2.0, 12.0)) / 10.0
+    assert v.quantisation_u == pytest.approx(expected, rel=1e-6)
     assert v.stats.mean == pytest.approx(V_MPS, abs=3 * v.quantisation_u)
 
 
 def test_time_stamp_scatter_is_measured_and_enters_as_the_timing_term():
-    """Stamps scattered by 200 us: measured within 5 %; the term is ``|rate| sqrt(2)
-    sigma_t / T``."""
+    """Stamps scattered by 200 us: measured within 5 %; the term is ``|rate| sigma_t
+    sqrt(h_0 + h_B) / T`` (the end lines' leverages at the window's ends)."""
     rng = np.random.default_rng(4)
     run, omega = _run(rng, jitter_s=2e-4)
     t = run.streams["/wheel/encoder"]["t_s"].to_numpy()
     assert timing_scatter_s(t) == pytest.approx(2e-4, rel=0.05)
     w = window_rate(run, "wheel_omega_radps", 0.5, 19.5, 0.0)
-    span = 19.0
-    assert w.timing_u == pytest.approx(omega * math.sqrt(2) * 2e-4 / span, rel=0.06)
+    expected = omega * 2e-4 * math.sqrt(_end_leverages(t, 0.5, 19.5)) / 19.0
+    assert w.timing_u == pytest.approx(expected, rel=0.06)
 
 
 def test_a_logged_rate_is_integrated_and_its_rounding_dithered_away():
