@@ -56,6 +56,17 @@ CMU_ROOT = Path("/work/shared/data/cmu-3d-terramechanics")
 CMU_MAP = "cmu_3d_terramechanics"
 
 
+def seed_text(seeds) -> str:
+    """Seeds as ranges: ``278-282, 285-289``."""
+    seeds, parts = sorted(int(s) for s in seeds), []
+    for seed in seeds:
+        if parts and seed == parts[-1][1] + 1:
+            parts[-1][1] = seed
+        else:
+            parts.append([seed, seed])
+    return ", ".join(f"{a}-{b}" if b > a else f"{a}" for a, b in parts)
+
+
 def _covered_by(scores: pd.DataFrame, column: str, quantities) -> pd.DataFrame:
     """Coverage per quantity (rows, in the order of ``quantities``) and ``column`` (columns)."""
     return scores.pivot_table(index="quantity", columns=column, values="covered",
@@ -93,7 +104,7 @@ def summary(generator: str, seeds, runs: int, scores: list[pd.DataFrame],
     table = coverage(pooled)
     modes = _covered_by(pooled, "mode", table.index)
     per_seed = _covered_by(pooled, "seed", table.index)
-    print(f"{generator} (seeds {seeds[0]}-{seeds[-1]}, {len(seeds)} x {runs} runs, "
+    print(f"{generator} (seeds {seed_text(seeds)}, {len(seeds)} x {runs} runs, "
           f"{seconds:.0f} s):")
     print(table.round(3).to_string())
     print(f"{generator}, coverage by run mode:\n{modes.round(3).to_string()}")
@@ -156,7 +167,7 @@ def markdown(numbers: dict) -> str:
         if generator not in numbers:
             continue
         g = numbers[generator]
-        lines += [f"## {generator}: seeds {g['seeds'][0]}-{g['seeds'][-1]}, "
+        lines += [f"## {generator}: seeds {seed_text(g['seeds'])}, "
                   f"{len(g['seeds'])} x {g['runs_per_seed']} runs", ""]
         lines += _markdown_table(g["by_quantity"], ["runs", "coverage", "coverage_lo",
                                                     "coverage_hi", "z_std", "z_median",
