@@ -5,8 +5,9 @@ the speeds and hub height alone and the lack of forces is flagged.
 Measured differences (ours - authors), 27 logs: wheel surface speed within 0.09 mm/s (0.23 %) and
 slip within 0.0026 (median 0.0003; slip from the window's displacements, here the logged
 speeds' time integrals) except the locked wheel (Vry = 0: 0.16 mm/s, slip 0.015, the logged
-wheel creeps at about +-1 mm/s; 0.062 from the mean of per-sample slips); hub height within 0.10 mm (the hub still creeps by
-0.1-0.3 mm after 50 s on some runs; our windows are 13-41 s long, theirs 5 s).
+wheel creeps at about +-1 mm/s; 0.062 from the mean of per-sample slips); hub height within
+0.10 mm (the hub still creeps by 0.1-0.3 mm after 50 s on some runs; our windows are 13-41 s
+long, theirs 5 s).
 """
 
 from __future__ import annotations
