@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Iterable
 from dataclasses import replace
 from html import escape
@@ -13,6 +14,7 @@ from campaign_report.images import to_png
 from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from run_results.traces import MAX_TRACE_POINTS
 from swtlab.rounding import plain, value_and_u
+from swtlab.domain.results import not_measured_heads
 from wpm_export import WheelPerformanceModule
 
 RUNS = "runs"
@@ -53,6 +55,21 @@ def _window(run: RunRecord) -> str:
     return f"{run.window_start_s:.1f}-{run.window_end_s:.1f}"
 
 
+def not_measured_note(data: CampaignData) -> str:
+    """What the runs' budgets could not measure, so u( ) leaves it out, with how many runs
+    (the ``not_measured`` column of ``swtlab results``); empty when nothing is missing."""
+    column = data.results.get("not_measured")
+    if column is None:
+        return ""
+    counts = Counter(head for cell in column for head in not_measured_heads(cell))
+    if not counts:
+        return ""
+    items = ", ".join(f"{head} ({n} of {len(data.results)} runs)"
+                      for head, n in sorted(counts.items()))
+    return (f"Not measured, so not in u( ): {items}. The budgets hold what these runs "
+            "could measure; swtlab results --json gives each run's not_measured in full.")
+
+
 def runs_section(data: CampaignData) -> Section:
     """Every run: conditions, status, stable window, main means, flags and reasons."""
     header = ["run", "mode", "load [N]", "multipass", "slip set [%]", "velocity [mm/s]",
@@ -90,7 +107,8 @@ def runs_section(data: CampaignData) -> Section:
                  "same decimal (GUM 7.2.6). A run's flags and reasons are under its row. A run "
                  "id opens its time series.")
     numeric = frozenset({2, 3, 4, 5, *range(8, 8 + 2 * len(TABLE_QUANTITIES))})
-    return Section(RUNS, "Runs", [Note(summary), Table(
+    heads = [Note(summary)] + ([Note(missing)] if (missing := not_measured_note(data)) else [])
+    return Section(RUNS, "Runs", [*heads, Table(
         header, rows, numeric=numeric, row_classes=classes, html_columns=frozenset({0, 6}),
         row_notes=notes)])
 

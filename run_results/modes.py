@@ -12,7 +12,9 @@ import numpy as np
 import pandas as pd
 
 from run_results.result import RunResult
-from swtlab.domain.results import COLUMNS, WHEEL_COLUMNS, budget_columns, check_results
+from swtlab.domain.replicates import with_repeatability
+from swtlab.domain.results import (COLUMNS, WHEEL_COLUMNS, budget_columns, check_results,
+                                   not_measured_text)
 
 
 GROUP = ["wheel", "soil", "multipass", "load_set_n"]
@@ -27,7 +29,9 @@ def results_row(r: RunResult) -> dict:
            "slip_setpoint": c["slip_setpoint"], "velocity_set_mps": c["velocity_mps"],
            "gravity_mps2": c["gravity_mps2"], "steer_deg": c["steer_deg"], "status": r.status,
            "flags": "; ".join(r.flags), "window_found": w.found, "window_start_s": w.start_s,
-           "window_end_s": w.end_s, "window_method": w.method, "no_window_reason": w.reason}
+           "window_end_s": w.end_s, "window_method": w.method, "no_window_reason": w.reason,
+           "not_measured": not_measured_text(m for b in r.uncertainty.values()
+                                             for m in b.not_measured)}
     for name, q in r.quantities.items():
         row.update({f"{name}_mean": q.mean, f"{name}_std": q.std, f"{name}_se": q.se})
         if name in r.uncertainty:
@@ -41,7 +45,7 @@ def results_table(results: list[RunResult]) -> pd.DataFrame:
     code without a database; checked against the schema (``swtlab.domain.check_results``)."""
     table = pd.DataFrame.from_records([results_row(r) for r in results],
                                       columns=None if results else list(COLUMNS))
-    return check_results(table)
+    return check_results(with_repeatability(table))
 
 
 def resistance_at_zero_slip(slip: np.ndarray, resistance_n: np.ndarray,

@@ -7,7 +7,8 @@ Ground Vehicles, 4th ed., ch. 4), sinkage and hub height after the rig correctio
 steered runs also the side force ``fy`` and the slip angle (logged channel, else the
 set steering angle). Plausibility and sensor health (``plausibility``: saturation, dead
 channels, SE of 0, negative load or sinkage, set against measured load, metadata ranges,
-dig-in) are checked on the calibrated, zeroed channels and flag the run. Single-channel
+dig-in) are checked on the calibrated, zeroed channels and flag the run. Wheel speed, travel
+velocity and slip come from the window's displacements (``rates``). Single-channel
 quantities come from the native samples, the means of resistance and sinkage from the
 channels' native means (``native``). Given the run's track photos as measured
 (``image_slip``: the slip read from the grouser marks by ``softflow.track_run``, which the
@@ -30,14 +31,17 @@ from run_results.phase_average import phase_average, phase_bins
 from run_results.plausibility import plausibility_flags
 from run_results.rest_readings import ends_moving, rest_readings
 from run_results.result import RunResult
-from run_results.stats import QuantityStats, batch_means_se, pitch_batches, quantity_stats
+from run_results.rates import SOURCES, window_rate, window_slip
+from run_results.stats import QuantityStats, pitch_batches, quantity_stats
 from run_results.traces import run_traces
-from run_results.uncertainty_budget import RATES, BudgetParams, run_budget
+from run_results.uncertainty_budget import BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
 from swtlab.domain.results import wheel_columns
 from swtlab.order_stats import median
 
+#: quantities from the window's displacements (``run_results.rates``)
+RATES = ("slip", "travel_velocity_mps", "wheel_omega_radps")
 FORCE_CHANNELS = ("fx_n", "fy_n", "fz_n", "tx_nm", "ty_nm", "tz_nm", "dp_n")
 #: a measured passing frequency this far from n*omega/2pi is flagged
 GROUSER_MISMATCH_RATIO = 0.05
@@ -150,6 +154,27 @@ def _flags(run, window, oscillation: dict) -> list[str]:
     return flags
 
 
+def _rates(run, window, series, lo: int, hi: int) -> dict:
+    """Wheel speed, travel velocity and slip from the window's displacements
+    (``run_results.rates``); ``std``: the spread of the per-sample series (what one reading
+    scatters by)."""
+    def spread(key: str) -> float:
+        y = series[key][0][lo:hi]
+        return float(np.nanstd(y, ddof=1)) if np.isfinite(y).sum() > 1 else float("nan")
+
+    out = {}
+    for key in SOURCES:
+        found = window_rate(run, key, window.start_s, window.end_s, spread(key))
+        if found is not None:
+            out[key] = found
+    if len(out) == len(SOURCES):
+        found = window_slip(out["wheel_omega_radps"], out["travel_velocity_mps"],
+                            run.metadata.wheel.radius_m, spread("slip"))
+        if found is not None:
+            out["slip"] = found
+    return out
+
+
 def _image_slip(image) -> tuple[dict[str, QuantityStats], list[str]]:
     """``image_slip`` from the measured track photos (beside the encoder slip), and its flags;
     ``image``: a ``softflow.track_run.RunImageSlip`` or None."""
@@ -195,7 +220,11 @@ def process_run(run, params: StablePhaseParams | None = None,
     native, combined = native_quantities(run, window.start_s, window.end_s,
                                          {k: u for k, (_, u) in series.items()}, frequency, rig)
     phase = phase_bins(t[lo:hi], frequency) if frequency else None
+    rates = _rates(run, window, series, lo, hi)
+    quantities.update({k: r.stats for k, r in rates.items()})
     for key, (y, unit) in series.items():
+        if key in RATES:
+            continue
         average = None
         finite = int(np.isfinite(y[lo:hi]).sum())
         if frequency and finite > 16:
@@ -205,10 +234,7 @@ def process_run(run, params: StablePhaseParams | None = None,
             y[lo:hi], unit, average)
         if stats is not None:
             quantities[key] = stats
-            if key in RATES:
-                batches[key] = batch_means_se(y[lo:hi], None if average is None
-                                              else average["periodic"])
-            elif average is not None:
+            if average is not None:
                 batches[key] = pitch_batches(y[lo:hi], pitch, average["periodic"], dt_s)
     quantities.update({k: replace(quantities[k], mean=v) for k, v in combined.items()
                        if k in quantities})
@@ -217,7 +243,7 @@ def process_run(run, params: StablePhaseParams | None = None,
     rests = rest_readings(run)
     corrections["rest_readings"] = None if rests is None else rests.to_dict()
     quantities, budgets = run_budget(run, (window.start_s, window.end_s), quantities, rests,
-                                     budget, batches, frequency)
+                                     budget, batches, frequency, rates)
     flags = (*_flags(run, window, oscillation), *image_flags,
              *plausibility_flags(run, window, quantities, params or StablePhaseParams()))
     return RunResult(status="flagged" if flags else "ok", flags=flags, quantities=quantities,

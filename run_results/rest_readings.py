@@ -12,6 +12,7 @@ than :data:`MIN_REST_S` is not used. Their means carry an autocorrelation-correc
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,6 +63,17 @@ def resolution(values) -> float:
     steps = np.diff(v)
     steps = steps[steps > 1e-9 * float(np.max(np.abs(v)))]
     return float(steps.min()) if steps.size else 0.0
+
+
+def quantisation_u(q: float, spread: float) -> float:
+    """Standard uncertainty of the mean of readings rounded to a step ``q``: ``q/sqrt(12)``
+    (one uniform rounding error, GUM F.2.2.1) damped by ``exp(-2 pi^2 s^2 / q^2)`` for
+    readings spread by ``s`` (dithered by their own noise: the first harmonic of the
+    quantiser's mean error for Gaussian input, Widrow, Kollar & Liu 1996, IEEE Trans.
+    Instrum. Meas. 45(2) 353); 0 for ``q`` 0."""
+    if q <= 0:
+        return 0.0
+    return q / math.sqrt(12) * math.exp(-2 * math.pi**2 * (spread / q) ** 2)
 
 
 def _moving_span(t_s: np.ndarray, x: np.ndarray) -> tuple[float, float] | None:

@@ -66,19 +66,15 @@ def quantity_stats(y, unit: str, average: dict | None = None) -> QuantityStats |
 
 
 
-#: batches of :func:`batch_means_se`
-BATCHES = 20
-
-
-def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, float] | None:
-    """``(se, dof)`` of the window mean from non-overlapping batch means (Schmeiser 1982,
-    Operations Research 30(3) 556) with their lag-1 autocovariance (a Newey-West estimate on
-    the batch means, Newey & West 1987, Econometrica 55(3) 703, one lag at full weight), on
-    ``y`` less its ``periodic`` part (the phase-averaged grouser wave) where given. The lag-1
-    term takes out what one batch's end shares with the next: the telescoping noise of a rate
-    derived from noisy positions (which plain batch means overstate ``sqrt(B)`` times) and a
-    correlation spilling over one batch; so it sees a drive's slow ripple that ends a summed
-    autocorrelation early.
+def batch_se(residuals) -> tuple[float, float]:
+    """``(se, dof)`` of the window mean from the means of its ``B`` non-overlapping batches
+    (Schmeiser 1982, Operations Research 30(3) 556), given as ``residuals`` (the batch means
+    less any constant), with their lag-1 autocovariance (a Newey-West estimate on the batch
+    means, Newey & West 1987, Econometrica 55(3) 703, one lag at full weight). The lag-1
+    term takes out what one batch's end shares with the next: the telescoping noise of a
+    rate derived from noisy positions (which plain batch means overstate ``sqrt(B)`` times)
+    and a correlation spilling over one batch; so it sees a drive's slow ripple that ends a
+    summed autocorrelation early.
 
     With ``S0 = sum d_i^2``, ``S1 = sum d_i d_(i+1)`` of the batch means less their mean,
     for independent batch means of variance ``g``: ``E[S0 + 2 S1] = (B-1)(B-2) g / B`` (the
@@ -86,16 +82,10 @@ def batch_means_se(y, periodic=None, batches: int = BATCHES) -> tuple[float, flo
     ``se^2 = (S0 + 2 S1) / ((B-1)(B-2))`` is unbiased; ``Var(S0 + 2 S1) = 6 (B-1) g^2``
     (Gaussian), three times a plain sum of squares', so its degrees of freedom are
     Satterthwaite's ``2 E^2 / Var = (B-1)(B-2)^2 / (3 B^2)`` (Satterthwaite 1946, Biometrics
-    Bull. 2(6) 110; about 5 for 20 batches), not ``B - 2``. None with fewer than 4 finite
-    samples per batch; se 0 where the estimate is not positive (nothing resolved)."""
-    y = np.asarray(y, float)
-    if periodic is not None:
-        y = y - np.nan_to_num(np.asarray(periodic, float))
-    y = y[np.isfinite(y)]
-    size = y.size // batches
-    if size < 4:
-        return None
-    means = y[: size * batches].reshape(batches, size).mean(axis=1)
+    Bull. 2(6) 110; about 5 for 20 batches), not ``B - 2``. se 0 where the estimate is not
+    positive (nothing resolved)."""
+    means = np.asarray(residuals, float)
+    batches = means.size
     d = means - means.mean()
     var = (float(d @ d) + 2.0 * float(d[1:] @ d[:-1])) / ((batches - 1) * (batches - 2))
     dof = (batches - 1) * (batches - 2) ** 2 / (3.0 * batches**2)

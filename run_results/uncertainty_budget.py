@@ -4,13 +4,11 @@ combination, the effective degrees of freedom and the 95 % expanded uncertainty.
 Terms (standard uncertainties in the quantity's unit, each with its degrees of freedom):
 
 - ``statistical``: the window's autocorrelation-corrected SE (``run_results.stats``),
-  ``nu = n_eff - 1`` (Type A, GUM 4.2). For the rates derived from encoder positions (slip,
-  travel velocity, wheel speed) the batch-means SE with its lag-1 autocovariance
-  (``run_results.stats.batch_means_se``, Satterthwaite degrees of freedom) instead: the
-  derivative filter's noise is anti-correlated at short lags, so the autocorrelation sum,
-  which stops at the first negative pair, counts that noise in full and still ends before
-  a slow ripple of the drives is seen (with grousers, on the residual about the
-  phase-averaged wave). The other grousered quantities' by whole-pitch overlapping batch
+  ``nu = n_eff - 1`` (Type A, GUM 4.2). For the rates (slip, travel velocity, wheel speed),
+  which come from the window's displacements (``run_results.rates``), the batch-means SE of
+  their displacements with its lag-1 autocovariance (``run_results.stats.batch_se``,
+  Satterthwaite degrees of freedom): it sees a slow ripple of the drives, which an
+  autocorrelation sum ends before. The other grousered quantities' by whole-pitch overlapping batch
   means with the wave's end effect separated (``run_results.stats.pitch_batch_means_se``):
   a real grouser wave wanders in phase (passage by passage) but averages to zero over each
   pitch, so it reaches the window mean only at the window's ends, while batch means count
@@ -45,14 +43,21 @@ Terms (standard uncertainties in the quantity's unit, each with its degrees of f
 - ``quantisation``: of a step ``q`` read from the samples, ``q/sqrt(12)`` damped by
   ``exp(-2 pi^2 s^2 / q^2)`` for samples spread by ``s`` (dithered by their own noise: the
   first harmonic of the quantiser's mean error for Gaussian input, Widrow, Kollar & Liu 1996,
-  IEEE Trans. Instrum. Meas. 45(2) 353); load cells and the suspension arm.
+  IEEE Trans. Instrum. Meas. 45(2) 353; ``run_results.rest_readings.quantisation_u``); load
+  cells and the suspension arm. The rates: the encoders' step in the window's two end
+  values (local lines), ``(q/sqrt(12)) sqrt(h_0 + h_B) / T`` with ``h`` their leverages
+  (``run_results.rates``), propagated to slip.
+- ``timing``: the rates' time stamps, scattered by ``sigma_t`` measured from the stream's
+  intervals, in the same end values: ``|rate| sigma_t sqrt(h_0 + h_B) / T``
+  (``run_results.rates``), propagated to slip.
 - ``phase_sampling``: a sensor sampling a sharp-edged grouser wave only ``m`` times a period
   sees few of its phases; the rectangle rule over a period errs by at most ``drop / (2 m)``
   for a jump ``drop`` (the largest step between adjacent phase bins of the waveform), a
   bound taken as rectangular (GUM 4.3.7). Load cells and the suspension arm, with grousers.
 - ``clock``: the loggers' rate error, rectangular within ``+-clock_rate_bound_ppm`` (the
   logger's stated clock tolerance), relative on speeds, ``(1 - |s|) sqrt(2) u`` on slip (the
-  wheel and sled encoders' clocks apart).
+  wheel and sled encoders' clocks apart: ``|ds/d ln(r w)| = |ds/d ln v| = 1 - |s|`` for
+  both the driving and the skid definitions).
 
 Combined: root sum of squares of independent terms (GUM 5.1.2); effective degrees of freedom
 by Welch-Satterthwaite (GUM G.4.1); ``k`` the Student-t 97.5 % point (GUM G.3.2), or, with a
@@ -70,7 +75,7 @@ from scipy import optimize, special
 
 from run_results.native import MIN_SAMPLES_PER_BIN, channel_samples, hub_samples
 from run_results.phase_average import phase_average
-from run_results.rest_readings import RestReadings, resolution
+from run_results.rest_readings import RestReadings, quantisation_u, resolution
 from run_results.stats import PitchBatches, QuantityStats
 from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
 from swtlab.order_stats import median
@@ -85,8 +90,6 @@ FIELD_OF = {"dp_n": ("/tether/force", "dp"), "ty_nm": ("/hub/wrench", "ty"),
 SPEEDS = ("travel_velocity_mps", "wheel_omega_radps")
 #: the loggers' clock tolerance assumed where none is stated (a common quartz class)
 DEFAULT_CLOCK_PPM = 100.0
-#: rates derived from encoder positions (their statistical term also by batch means)
-RATES = ("slip", *SPEEDS)
 INF = math.inf
 
 
@@ -344,12 +347,6 @@ def pooled_diffusion(rest_records: list[dict]) -> dict[str, Term]:
     return {c: Term(max(num, 0.0) / span, float(runs)) for c, (num, span, runs) in sums.items()}
 
 
-def _quantisation(q: float, spread: float) -> float:
-    if q <= 0:
-        return 0.0
-    return q / math.sqrt(12) * math.exp(-2 * math.pi**2 * (spread / q) ** 2)
-
-
 def phase_sampling(t_s: np.ndarray, y: np.ndarray, frequency_hz: float | None) -> Term | None:
     """Bound ``drop / (2 m)`` on the window mean of a periodic wave sampled ``m`` times a
     period (module doc), as a rectangular term; None without a frequency or samples."""
@@ -394,7 +391,7 @@ def _cell_budget(run, rests, window_s, key: str, s: QuantityStats,
         terms["calibration"] = Term(math.hypot(gain_u * abs(mean), offset))
     native = channel_samples(run, column, *window_s)
     if native is not None:
-        terms["quantisation"] = Term(_quantisation(resolution(native[1]) / scale, s.std))
+        terms["quantisation"] = Term(quantisation_u(resolution(native[1]) / scale, s.std))
         sampling = phase_sampling(native[0], native[1] / scale, frequency_hz)
         if sampling is not None:
             terms["phase_sampling"] = sampling
@@ -423,37 +420,26 @@ def _batch_statistical(s: QuantityStats, batch: PitchBatches | None) -> BatchSta
     return None if batch is None else BatchStatistical(batch, _statistical(s))
 
 
-def _rate_statistical(s: QuantityStats, batch: tuple[float, float] | None) -> Term:
-    """A rate's batch-means term, at least the noise of the positions at the window's two
-    ends, which every rate from positions keeps: its mean is ``(x_n - x_0) / T``, and with
-    position noise ``sigma`` the rate's samples spread by ``s = sqrt(2) sigma / dt``, so
-    ``sqrt(2) sigma / T = s / n`` (where the batches resolve nothing, this is what is left)."""
-    if batch is None:
-        return _statistical(s)
-    return Term(max(batch[0], s.std / s.n), batch[1])
-
-
-def _speed_budget(s: QuantityStats, params: BudgetParams, batch) -> dict:
-    """Statistics and the clock (the encoders' resolution, a step over the whole window,
-    is far below both)."""
-    terms = {"statistical": _rate_statistical(s, batch),
-             "clock": Term(abs(s.mean) * params.clock_ppm * 1e-6 / math.sqrt(3),
-                           rectangular=True)}
-    return terms
+def _rate_terms(rate, clock_rel_u: float) -> dict[str, Term]:
+    """A rate's terms (``run_results.rates.RateEstimate``): statistical, quantisation, timing,
+    and the clock, ``clock_rel_u`` (standard, of a rectangle) times the rate for a speed."""
+    return {"statistical": Term(rate.stats.se, rate.dof),
+            "quantisation": Term(rate.quantisation_u), "timing": Term(rate.timing_u),
+            "clock": Term(clock_rel_u, rectangular=True)}
 
 
 def run_budget(run, window_s: tuple[float, float], quantities: dict[str, QuantityStats],
                rests: RestReadings | None, params: BudgetParams | None = None,
-               batches: dict | None = None,
-               frequency_hz: float | None = None) -> tuple[dict[str, QuantityStats],
-                                                           dict[str, QuantityBudget]]:
+               batches: dict | None = None, frequency_hz: float | None = None,
+               rates: dict | None = None) -> tuple[dict[str, QuantityStats],
+                                                   dict[str, QuantityBudget]]:
     """``(corrected quantities, budgets)``: every quantity's budget and its mean with the
-    re-zeroing correction added (module doc); ``batches``: the rates' batch-means ``(se,
-    dof)`` (``run_results.stats.batch_means_se``), the other grousered quantities'
-    ``run_results.stats.PitchBatches``; ``frequency_hz``: the
-    grouser passing frequency (None: no grousers)."""
+    re-zeroing correction added (module doc); ``batches``: the grousered quantities'
+    ``run_results.stats.PitchBatches``; ``frequency_hz``: the grouser passing frequency
+    (None: no grousers); ``rates``: speeds and slip from displacements
+    (``run_results.rates.RateEstimate``)."""
     params = params or BudgetParams()
-    batches = batches or {}
+    batches, rates = batches or {}, rates or {}
     budgets: dict[str, QuantityBudget] = {}
     for key, s in quantities.items():
         if key in CELL_OF:
@@ -468,18 +454,19 @@ def run_budget(run, window_s: tuple[float, float], quantities: dict[str, Quantit
         if key in quantities:
             budgets[key] = _height_budget(run, key, quantities[key], window_s, budgets,
                                           frequency_hz, batches.get(key))
+    clock_rel = params.clock_ppm * 1e-6 / math.sqrt(3)
     for key in SPEEDS:
-        if key in quantities:
-            budgets[key] = QuantityBudget(quantities[key].unit, 0.0,
-                                          _speed_budget(quantities[key], params,
-                                                        batches.get(key)), params.clock_missing)
-    if "slip" in quantities:
-        s = quantities["slip"]
-        clock = (1 - min(abs(s.mean), 1.0)) * math.sqrt(2) * params.clock_ppm * 1e-6
-        budgets["slip"] = QuantityBudget(s.unit, 0.0, {"statistical": _rate_statistical(
-                                                            s, batches.get("slip")),
-                                                       "clock": Term(clock / math.sqrt(3))},
-                                         params.clock_missing)
+        if key in rates:
+            budgets[key] = QuantityBudget(
+                rates[key].stats.unit, 0.0,
+                _rate_terms(rates[key], abs(rates[key].stats.mean) * clock_rel),
+                params.clock_missing)
+    if "slip" in rates:
+        s = rates["slip"].stats
+        terms = _rate_terms(rates["slip"], 0.0)
+        # two independent clocks: the sum of two rectangles is not one
+        terms["clock"] = Term((1 - min(abs(s.mean), 1.0)) * math.sqrt(2) * clock_rel)
+        budgets["slip"] = QuantityBudget(s.unit, 0.0, terms, params.clock_missing)
     for key, s in quantities.items():
         budgets.setdefault(key, QuantityBudget(s.unit, 0.0, {"statistical": _statistical(s)},
                                                ("only the window statistics",)))
@@ -496,7 +483,7 @@ def _height_budget(run, key: str, s: QuantityStats, window_s, budgets: dict,
     terms = {"statistical": _statistical(s)}
     hub = hub_samples(run, *window_s)
     if hub is not None:
-        terms["quantisation"] = Term(_quantisation(resolution(hub[1]), s.std))
+        terms["quantisation"] = Term(quantisation_u(resolution(hub[1]), s.std))
         sampling = phase_sampling(hub[0], hub[1], frequency_hz)
         if sampling is not None:
             terms["phase_sampling"] = sampling

@@ -24,10 +24,19 @@ may be right to a quarter of the repeatability floor or wrong by as much as the 
 itself: 128 floors is about the wheel load in drawbar pull at the loads of a lab campaign
 (the floor is 1 % of the load + 0.3 N), and no model misses a force by more than the load it
 carries (:data:`TAU_GRID`). A smooth error common to every source and level is discrepancy,
-not evidence for an effect, whatever its size. The discrepancy is *shared*: one function of slip and load for every
-source, multipass level and gravity level, so an error common to sibling sources (a smooth
-and a lugged wheel on one soil) cancels in their contrast, which only an effect (or the
-hypothesis "outside the candidates", :func:`log_evidence`'s ``outside``) can carry.
+not evidence for an effect, whatever its size. The discrepancy is *shared*: one function of
+slip and load for every source, multipass level and gravity level, so an error common to
+sibling sources (a smooth and a lugged wheel on one soil) cancels in their contrast, which
+only an effect (or the hypothesis "outside the candidates", :func:`log_evidence`'s
+``outside``) can carry.
+
+The base model's error also has a part that is not smooth in slip and load: what differs
+from one run to the next beyond the measured repeatability (the soil state under that run,
+a law's shape between two tested slips). It is a *nugget* (Kennedy & O'Hagan 2001 sec. 4.2;
+Gramacy & Lee 2012, "Cases for the nugget in modeling computer experiments", Statistics and
+Computing 22:713-722): independent per entry, ``nu`` times the floor, integrated over
+:data:`NUGGET_GRID` (none, or 1 to 64 floors, equal weights). Without it an error the smooth
+discrepancy cannot bend to is read as evidence for whichever effect bends the curve there.
 """
 
 from __future__ import annotations
@@ -49,6 +58,8 @@ LENGTH_SLIP = 0.3
 LENGTH_LOG_LOAD = 0.5
 #: the shared discrepancy's amplitude in units of the repeatability floor (log-uniform)
 TAU_GRID = np.geomspace(0.25, 128.0, 10)
+#: the nugget's size in units of the floor (module docstring)
+NUGGET_GRID = np.array([0.0, 1.0, 4.0, 16.0, 64.0])
 #: prior standard deviation of a profiled offset (a relative sinkage's unknown zero), m
 OFFSET_PRIOR_SD_M = 0.1
 
@@ -114,7 +125,8 @@ def _log_normal(r: np.ndarray, cov: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class Evidence:
-    """Log evidence (natural log) and the posterior weights of the discrepancy grid."""
+    """Log evidence (natural log) and the posterior weights of the shared discrepancy's sizes
+    (:data:`TAU_GRID`, summed over the other grids)."""
 
     log_evidence: float
     tau_weights: np.ndarray
@@ -131,16 +143,19 @@ def log_evidence(obs: Observations, predicted: np.ndarray, jac: np.ndarray,
     """The linearised-Laplace log evidence of a candidate whose MAP predicts ``predicted``
     (flat, the entries of ``obs``) with Jacobian ``jac`` (entries x parameters, internal
     coordinates), ``offset_from_prior = u* - mu`` and prior standard deviations
-    ``prior_sd``; integrated over :data:`TAU_GRID`. ``outside``: amplitudes (floor units) of
-    a second discrepancy apart per group (source, multipass, gravity level), integrated
-    log-uniformly too: the hypothesis that an effect outside the candidates is at work."""
+    ``prior_sd``; integrated over :data:`TAU_GRID` and :data:`NUGGET_GRID`. ``outside``:
+    amplitudes (floor units) of a second discrepancy apart per group (source, multipass,
+    gravity level), integrated log-uniformly too: the hypothesis that an effect outside the
+    candidates is at work."""
     residual = obs.y - np.nan_to_num(predicted, nan=0.0) + jac @ offset_from_prior
     base = (np.diag(obs.sigma ** 2) + (jac * prior_sd ** 2) @ jac.T
             + OFFSET_PRIOR_SD_M ** 2 * obs.offsets @ obs.offsets.T)
     outside = np.zeros(1) if outside is None else np.asarray(outside, float)
-    grid = [[_log_normal(residual, base + t ** 2 * obs.kernel_shared
-                         + o ** 2 * obs.kernel_grouped) for o in outside] for t in TAU_GRID]
-    logs = np.array(grid) - np.log(len(TAU_GRID) * len(outside))
+    floor2 = np.diag(obs.floor ** 2)
+    grid = np.array([[[_log_normal(residual, base + t ** 2 * obs.kernel_shared
+                                   + o ** 2 * obs.kernel_grouped + v ** 2 * floor2)
+                       for v in NUGGET_GRID] for o in outside] for t in TAU_GRID])
+    logs = grid.reshape(len(TAU_GRID), -1) - np.log(grid.size)
     total = float(logsumexp(logs))
     weights = np.exp(logsumexp(logs, axis=1) - total)
     return Evidence(total, weights)

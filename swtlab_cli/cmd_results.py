@@ -11,11 +11,13 @@ import pandas as pd
 
 from swtlab_cli import exit_codes
 from swtlab.atomic import atomic_file
+from swtlab.domain.results import not_measured_heads
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
                    "window_start_s", "window_end_s", "slip_mean", "slip_u95", "dp_n_mean",
                    "dp_n_se", "dp_n_u95", "torque_nm_mean", "torque_nm_u95", "sinkage_m_mean",
-                   "sinkage_m_u95", "resistance_n_mean", "resistance_n_u95", "image_slip_mean"]
+                   "sinkage_m_u95", "resistance_n_mean", "resistance_n_u95", "image_slip_mean",
+                   "not_measured"]
 
 REPLICATE_COLUMNS = ["wheel", "mode", "multipass", "load_set_n", "slip_setpoint", "quantity",
                      "runs", "mean", "replicate_sd", "within_u", "ratio", "larger"]
@@ -158,6 +160,9 @@ def run(args: argparse.Namespace) -> int:
         print(shown(table[columns], REPLICATE_U).to_string(index=False))
     else:
         columns = [c for c in SUMMARY_COLUMNS if c in every.columns]
+        if "not_measured" in every:  # the items' heads here; the full text in --csv/--json
+            every = every.assign(not_measured=every["not_measured"].map(
+                lambda v: "; ".join(not_measured_heads(v))))
         print(shown(every[columns], SUMMARY_U).to_string(index=False))
         for row in failed.itertuples():
             print(f"failed: {row.run_id}: {row.flags} [{row.failure_type}]")

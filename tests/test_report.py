@@ -337,6 +337,9 @@ def test_run_table_shows_each_runs_stored_standard_uncertainty(small):
             assert len(mean.partition(".")[2]) == len(u.partition(".")[2]), (name, mean, u)
             checked += 1
     assert checked == 4 * 19
+    # beside u( ): what the budgets left out (the sample has no replicates, no calibration keys)
+    note = re.search(r"Not measured, so not in u\( \): (.*?)\.", unescape(text)).group(1)
+    assert "run-to-run repeatability (" in note and "calibration (" in note
 
 
 def test_hidden_error_bars_get_a_note_and_repeatability_follows_the_run_table(small):

@@ -228,3 +228,34 @@ def test_ingest_reads_the_specs_calibration_uncertainty_keys(tmp_path):
     u = run.metadata.calibration_u
     assert u[("/tether/force", "dp")] == (sensors.gain_rel_u, sensors.dp_offset_u_n)
     assert u[("/hub/wrench", "fz")][0] == sensors.gain_rel_u
+
+
+def test_low_speed_mode_logs_a_14_bit_wheel_encoder_and_the_sled_at_500_hz(tmp_path):
+    """``low_speed_rig``: at 10 mm/s with the set slip 0.05 the wheel (r 0.1 m) turns
+    0.105 rad/s, 0.55 counts of 2 pi/16384 a sample at 500 Hz; the files say so (read with
+    the standard library), and the rest of the rig is unchanged."""
+    from validation.second_rig import low_speed_rig
+
+    write_campaign(tmp_path, [RunCondition("slow", "speed_control", 150.0, 0.05)],
+                   constant_law, seed=4, form="csv", rig=low_speed_rig(Rig(sensors=QUIET)))
+    folder = tmp_path / "campaign" / "slow"
+
+    def column(name: str, index: int) -> tuple[np.ndarray, np.ndarray]:
+        with open(folder / name) as f:
+            rows = list(csv.reader(f))[1:]
+        return (np.array([float(r[0]) for r in rows]), np.array([float(r[index]) for r in rows]))
+
+    t, angle = column("wheel_encoder.csv", 1)
+    assert 1 / np.median(np.diff(t)) == pytest.approx(500.0, rel=1e-3)
+    counts = angle / (2 * math.pi / 2**14)
+    assert np.allclose(counts, np.round(counts), atol=1e-4)   # the file's decimal digits
+    counts = np.round(counts)
+    moving = (t > 30.0) & (t < 45.0)
+    per_sample = np.diff(counts[moving])
+    assert set(np.unique(per_sample)) <= {0.0, 1.0}
+    assert per_sample.mean() == pytest.approx(0.01 / 0.95 / 0.1 / 500 / (2 * math.pi / 2**14),
+                                              rel=0.01)
+    t_sled, _ = column("sled_encoder.csv", 1)
+    assert 1 / np.median(np.diff(t_sled)) == pytest.approx(500.0, rel=1e-3)
+    t_wrench, _ = column("hub_wrench.csv", 1)
+    assert 1 / np.median(np.diff(t_wrench)) == pytest.approx(120.0, rel=1e-3)

@@ -425,6 +425,7 @@ class RunUncertainty(Base):
     u_quantisation: Mapped[float | None] = mapped_column(Float, nullable=True)
     u_phase_sampling: Mapped[float | None] = mapped_column(Float, nullable=True)
     u_clock: Mapped[float | None] = mapped_column(Float, nullable=True)
+    u_timing: Mapped[float | None] = mapped_column(Float, nullable=True)
     u: Mapped[float | None] = mapped_column(Float, nullable=True)
     dof: Mapped[float | None] = mapped_column(Float, nullable=True)
     k: Mapped[float | None] = mapped_column(Float, nullable=True)

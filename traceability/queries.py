@@ -6,7 +6,9 @@ import pandas as pd
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from swtlab.domain.results import COLUMNS, budget_columns, check_results, wheel_columns
+from swtlab.domain.replicates import with_repeatability
+from swtlab.domain.results import (COLUMNS, budget_columns, check_results, not_measured_text,
+                                   wheel_columns)
 
 from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult,
                                  RunUncertainty, Soil, StableWindow, TestCondition, Wheel)
@@ -43,9 +45,11 @@ def latest_results(session: Session) -> pd.DataFrame:
             {f"{q.quantity}_{stat}": getattr(q, stat) for stat in STATS})
     budgets = session.execute(select(RunUncertainty).where(
         RunUncertainty.run_result_id.in_(result_ids))).scalars().all() if result_ids else []
+    missing: dict[int, list[str]] = {}
     for b in budgets:
         by_result.setdefault(b.run_result_id, {}).update(budget_columns(b.quantity, {
             c.key: getattr(b, c.key) for c in RunUncertainty.__table__.columns}))
+        missing.setdefault(b.run_result_id, []).extend(b.not_measured or [])
     records = []
     for row in rows:
         cond, result, window = row.TestCondition, row.RunResult, row.StableWindow
@@ -61,7 +65,8 @@ def latest_results(session: Session) -> pd.DataFrame:
             "flags": "; ".join(result.flags), "window_found": window.found,
             "window_start_s": window.start_s, "window_end_s": window.end_s,
             "window_method": window.method, "no_window_reason": window.reason,
+            "not_measured": not_measured_text(missing.get(result.id, [])),
             **by_result.get(result.id, {}), **result.oscillation,
             "result_id": result.id})
-    return check_results(pd.DataFrame.from_records(records, columns=None if records
-                                                   else list(COLUMNS)))
+    return check_results(with_repeatability(pd.DataFrame.from_records(
+        records, columns=None if records else list(COLUMNS))))

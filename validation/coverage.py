@@ -8,7 +8,11 @@ then each run's ``mean +- u95`` is checked against its truth:
   law's steady values (wheel load: the set load; speeds: the noise-free window means);
 - ``second``: the second rig (validation/second_rig, independent of the estimators), with the
   spec's calibration-uncertainty keys written; truth the caller's steady values (the shipped
-  ``bb2_sand`` model, ``ModelTruth``).
+  ``bb2_sand`` model, ``ModelTruth``);
+- ``low_speed``: the same rig in its low-speed coarse-encoder mode
+  (``validation.second_rig.low_speed_rig``: a 14-bit wheel encoder and the sled encoder at
+  500 Hz), sled speeds 5-20 mm/s (log-uniform), where a wheel turns zero or one count a
+  sample.
 
 The campaign's ``swtlab.toml`` states the loggers' clock tolerance the way a lab states its
 logger's datasheet value, and the shortest and longest time from zeroing the load cells to a
@@ -27,7 +31,7 @@ import pandas as pd
 import swtlab
 import terramechanics as tm
 from validation.model_truth import ModelTruth
-from validation.second_rig import Rig, SensorModel, WheelGeometry, write_campaign
+from validation.second_rig import Rig, SensorModel, WheelGeometry, low_speed_rig, write_campaign
 from validation.second_rig import RunCondition as RigCondition
 from virtual_testbed import RunCondition, generate_campaign
 from virtual_testbed.sample_campaign import SAMPLE_RATES
@@ -36,7 +40,9 @@ from virtual_testbed.sensors import SensorModel as VirtualSensors
 #: the issue's quantities first, then the derived ones
 QUANTITIES = ("dp_n", "torque_nm", "wheel_load_n", "slip", "sinkage_m", "resistance_n",
               "travel_velocity_mps", "thrust_n", "wheel_omega_radps")
-GENERATORS = ("virtual", "second")
+GENERATORS = ("virtual", "second", "low_speed")
+#: sled speeds of the ``low_speed`` generator (m/s, drawn log-uniform)
+LOW_SPEEDS_MPS = (0.005, 0.02)
 
 
 def _draws(n: int, seed: int, loads: tuple[float, float]):
@@ -79,19 +85,24 @@ def write_virtual(out: Path, n: int, seed: int, duration_s: float = 60.0) -> dic
     return truths
 
 
-def write_second(out: Path, n: int, seed: int) -> dict[str, dict]:
-    """A second-rig campaign in ``out/campaign`` (CSV runs), truth from ``bb2_sand``."""
+def write_second(out: Path, n: int, seed: int, low_speed: bool = False) -> dict[str, dict]:
+    """A second-rig campaign in ``out/campaign`` (CSV runs), truth from ``bb2_sand``;
+    ``low_speed``: in the rig's low-speed coarse-encoder mode at :data:`LOW_SPEEDS_MPS`."""
     model = tm.shipped_model("bb2_sand")
     w, flex = model.wheel, model.effects.get("wheel_flexibility")
     wheel = WheelGeometry(name="bb2", radius_m=w.radius_m, width_m=w.width_m,
                           grouser_count=w.grouser_count, grouser_height_m=w.grouser_height_m,
                           stiffness_n_per_mm=flex.radial_stiffness_n_m / 1000 if flex else None)
+    speeds = np.exp(np.random.default_rng([seed, 1]).uniform(*np.log(LOW_SPEEDS_MPS), n))
     conds = [RigCondition(f"{kind[:2]}{i:03d}", kind, load,
                           slip if kind == "speed_control" else None, multipass=min(mp, 1),
-                          wheel=wheel)
+                          wheel=wheel, **({"velocity_mps": float(np.round(speeds[i], 4))}
+                                          if low_speed else {}))
              for i, kind, load, mp, slip in _draws(n, seed, (80.0, 300.0))]
     sensors = SensorModel(write_calibration_uncertainty=True)
-    write_campaign(out, conds, ModelTruth(model), seed, form="csv", rig=Rig(sensors=sensors))
+    rig = Rig(sensors=sensors)
+    write_campaign(out, conds, ModelTruth(model), seed, form="csv",
+                   rig=low_speed_rig(rig) if low_speed else rig)
     _settings(out / "campaign", sensors.clock_ppm_max, sensors.zero_lead_s)
     return {c.run_id: json.loads((out / "truth" / f"{c.run_id}.json").read_text())["steady"]
             for c in conds}
@@ -146,6 +157,7 @@ def run_coverage(out: str | Path, generator: str, n: int, seed: int) -> pd.DataF
     if generator not in GENERATORS:
         raise ValueError(f"generator {generator!r} not in {GENERATORS}")
     out = Path(out)
-    truths = (write_virtual if generator == "virtual" else write_second)(out, n, seed)
+    truths = (write_virtual(out, n, seed) if generator == "virtual"
+              else write_second(out, n, seed, low_speed=generator == "low_speed"))
     campaign = swtlab.process_campaign(out / "campaign", soil_flow=False)
     return score(campaign.results, truths)

@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from swtlab.domain.results import not_measured_text
+
 #: the columns that make two runs replicates of one condition
 REPLICATE_KEY = ("wheel", "soil", "mode", "multipass", "load_set_n", "slip_setpoint",
                  "velocity_set_mps", "gravity_mps2", "steer_deg")
@@ -17,6 +19,26 @@ QUANTITIES = ("slip", "dp_n", "torque_nm", "wheel_load_n", "sinkage_m", "resista
               "travel_velocity_mps")
 NO_REPLICATES = ("no replicate runs (no two runs share a test condition): run-to-run "
                  "repeatability not measured; only the within-run uncertainty is known")
+
+
+#: ``not_measured`` item of a run whose condition has no replicate in its table
+SINGLE_RUN = ("run-to-run repeatability (one run of this condition: no replicate spread "
+              "beside the within-run budget)")
+
+
+def with_repeatability(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with :data:`SINGLE_RUN` added to the ``not_measured`` column of every run
+    with a stable phase that no other run of the table replicates (:data:`REPLICATE_KEY`)."""
+    groups = _groups(table)
+    if groups is None or table.empty or "not_measured" not in table:
+        return table
+    size = groups["run_id"].transform("size").reindex(table.index)
+    single = size.eq(1)
+    out = table.copy()
+    out.loc[single, "not_measured"] = [
+        not_measured_text([*filter(None, str(v or "").split("; ")), SINGLE_RUN])
+        for v in out.loc[single, "not_measured"]]
+    return out
 
 
 def _within_u(table: pd.DataFrame, quantity: str) -> pd.Series:

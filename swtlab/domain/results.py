@@ -53,9 +53,27 @@ QUANTITIES: dict[str, str] = {
 
 #: terms of a quantity's uncertainty budget (``run_results.uncertainty_budget``)
 UNCERTAINTY_TERMS = ("statistical", "zero_drift", "calibration", "quantisation",
-                     "phase_sampling", "clock")
+                     "phase_sampling", "clock", "timing")
 #: results-table columns of a quantity's budget, ``<q>_<name>`` (docs/results.md)
 BUDGET_COLUMNS = ("u", "u95", "k", "dof", "correction", *(f"u_{t}" for t in UNCERTAINTY_TERMS))
+
+
+#: results-table column: what the run's budgets could not measure (docs/results.md)
+NOT_MEASURED = "not_measured"
+
+
+def not_measured_text(items) -> str:
+    """The ``not_measured`` column of a run: its budgets' ``not_measured`` items, each once,
+    sorted, ``'; '``-separated."""
+    return "; ".join(sorted(set(items)))
+
+
+def not_measured_heads(text) -> list[str]:
+    """The items of a ``not_measured`` cell without their explanations (the text before
+    ``' ('``), for a summary."""
+    if not isinstance(text, str) or not text:
+        return []
+    return sorted({item.split(" (")[0] for item in text.split("; ")})
 
 
 def budget_columns(quantity: str, budget: dict) -> dict:

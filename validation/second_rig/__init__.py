@@ -8,12 +8,12 @@ errors, quantisation, clocks, spikes) and writes MCAP or CSV runs, with the trut
 docs/second-rig.md.
 """
 
-from validation.second_rig.campaign import Rig, make_run, write_campaign
+from validation.second_rig.campaign import Rig, low_speed_rig, make_run, write_campaign
 from validation.second_rig.condition import (MODES, TRUTH_KEYS, RunCondition, SecondRigError,
                                              WheelGeometry, steady_truth, wheel_omega_radps)
 from validation.second_rig.sensors import Rates, SensorModel
 from validation.second_rig.signals import SignalModel, Timeline
 
 __all__ = ["MODES", "TRUTH_KEYS", "Rates", "Rig", "RunCondition", "SecondRigError",
-           "SensorModel", "SignalModel", "Timeline", "WheelGeometry", "make_run",
+           "SensorModel", "SignalModel", "Timeline", "WheelGeometry", "low_speed_rig", "make_run",
            "steady_truth", "wheel_omega_radps", "write_campaign"]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import hashlib
 import shutil
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
@@ -34,6 +34,24 @@ class Rig:
     signals: SignalModel = field(default_factory=SignalModel)
     sensors: SensorModel = field(default_factory=SensorModel)
     rates: Rates = field(default_factory=Rates)
+
+
+#: the low-speed coarse-encoder mode's encoders: a 14-bit wheel encoder and the sled
+#: encoder logged at 500 Hz (the wheel turns about half a count per sample at 10 mm/s)
+LOW_SPEED_WHEEL_COUNTS_PER_REV = 2**14
+LOW_SPEED_ENCODER_HZ = 500.0
+
+
+def low_speed_rig(rig: Rig | None = None) -> Rig:
+    """``rig`` (default: the rig as it is) with the low-speed coarse-encoder mode's encoders
+    (:data:`LOW_SPEED_WHEEL_COUNTS_PER_REV`, :data:`LOW_SPEED_ENCODER_HZ`): at a sled speed of
+    a few mm/s each sample's change is zero or one count, the case where averaging per-sample
+    ratios of differences is biased. The run's speed is the condition's ``velocity_mps``."""
+    rig = rig or Rig()
+    return replace(rig, sensors=replace(rig.sensors,
+                                        wheel_counts_per_rev=LOW_SPEED_WHEEL_COUNTS_PER_REV),
+                   rates=replace(rig.rates, wheel_encoder_hz=LOW_SPEED_ENCODER_HZ,
+                                 sled_encoder_hz=LOW_SPEED_ENCODER_HZ))
 
 
 def run_rng(seed: int, run_id: str) -> np.random.Generator:
