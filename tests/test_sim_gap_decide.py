@@ -14,7 +14,7 @@ from sim_gap import candidates
 from sim_gap.decide import CALL_PROBABILITY, by_effect_set, decide, posterior
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.discriminate import separating_test
-from sim_gap.evidence import TAU_GRID, Observations, log_evidence
+from sim_gap.evidence import NUGGET_GRID, TAU_GRID, Observations, log_evidence
 from sim_gap.hypotheses import (OUTSIDE, P_EFFECT, admissible, hypothesis_priors,
                                 outside_prior, set_prior)
 from sim_gap.siblings import contrasts
@@ -53,7 +53,7 @@ CANDIDATES = ["grousers", "slip_sinkage", "bulldozing"]
 
 def test_linearised_evidence_equals_the_integral_over_the_parameter():
     """A model linear in one parameter: the evidence is the integral of likelihood times
-    prior over the parameter and the discrepancy grid (numerical quadrature)."""
+    prior over the parameter and the discrepancy grids (numerical quadrature)."""
     rng = np.random.default_rng(3)
     x = np.linspace(0.0, 1.0, 8)
     sigma, floor = np.full(8, 0.3), np.full(8, 0.2)
@@ -64,11 +64,12 @@ def test_linearised_evidence_equals_the_integral_over_the_parameter():
     mu, sd, a_hat = 1.0, 0.8, 1.5  # prior N(1, 0.8^2); expanded at a = 1.5 (any point)
     got = log_evidence(obs, a_hat * x, x[:, None], np.array([a_hat - mu]), np.array([sd]))
 
-    def integrand(a, tau):
-        cov = np.diag(sigma ** 2) + tau ** 2 * kernel
+    def integrand(a, tau, nugget):
+        cov = np.diag(sigma ** 2 + (nugget * floor) ** 2) + tau ** 2 * kernel
         return (stats.multivariate_normal(a * x, cov).pdf(y) * stats.norm(mu, sd).pdf(a))
 
-    z = np.mean([integrate.quad(integrand, -6, 8, args=(t,))[0] for t in TAU_GRID])
+    z = np.mean([integrate.quad(integrand, -6, 8, args=(t, v))[0]
+                 for t in TAU_GRID for v in NUGGET_GRID])
     assert got.log_evidence == pytest.approx(np.log(z), abs=1e-6)
     assert got.tau_weights.sum() == pytest.approx(1.0)
 
