@@ -106,13 +106,6 @@ class FitResult:
     def n_params(self) -> int:
         return len(self.candidate.params)
 
-    @property
-    def aicc(self) -> float:
-        """AICc of a Gaussian fit with known sigmas, ``chi2 + 2k + 2k(k+1)/(n-k-1)``
-        (Hurvich & Tsai 1989, Biometrika 76(2):297-307)."""
-        n, k = self.n_residuals, self.n_params
-        return self.chi2 + 2 * k + (2 * k * (k + 1) / (n - k - 1) if n > k + 1 else np.inf)
-
 
 def fit_candidate(sim: Simulated, c: Candidate, points: pd.DataFrame,
                   sigma: dict[str, np.ndarray], start: dict[str, float] | None = None,
