@@ -10,8 +10,8 @@ caller names a subset; an effect the simulation already has keeps the simulation
 
 Pairs are fitted on a one-at-a-time design over laws (Saltelli et al. 2008, Global
 Sensitivity Analysis, ch. 2): every pair under the reference laws (each effect's law that
-scored best alone), and every pair with one of its effects switched to another law. The
-law robustness check (``sim_gap.laws``) then varies one effect's law at a time.
+scored best alone), and every pair with one of its effects switched to another law; the
+posterior sums each effect set over the laws it was fitted under (``sim_gap.decide``).
 """
 
 from __future__ import annotations

@@ -16,8 +16,7 @@ planetary-wheel ruts (3-40 mm, phi 28-38 deg, c up to 0.8 kPa): widened to 0-100
 Bekker's resistances (tried in 0.6.0), Rankine's law carried a Bekker bulldozing truth in
 size but not in shape, and wheel flexibility patched the shape into confident wrong
 "wheel_flexibility + bulldozing" calls on two independent campaigns (docs/gap-report.md,
-"0.6.0"). Pinned at 5, such a fit ends on its bound, and the diagnosis says
-``inconclusive`` (``sim_gap.identify``).
+"0.6.0"). Pinned at 5, such a fit ends on its bound.
 """
 
 from __future__ import annotations
