@@ -103,7 +103,7 @@ class Design:
     duration_s: float = 60.0
     #: also run every condition with :data:`SMOOTH_WHEEL` on the same soil, diagnosed as a
     #: second measured source: the design that tells the soil's slip-sinkage from the lugs'
-    #: (their contrast, sim_gap.siblings; Ding et al. 2011 ran a smooth and lugged wheels on one soil)
+    #: (their contrast, sim_gap.siblings; Ding et al. 2011 ran a smooth and a lugged wheel)
     smooth_wheel: bool = False
 
 
