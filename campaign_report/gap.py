@@ -31,6 +31,7 @@ from campaign_report.figures import (condition_text, gap_curves, gap_heatmap,
 from campaign_report.html import Block, Heading, Image, Note, Page, Section, Table, render_page
 from campaign_report.images import to_png
 from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, value_text
+from sim_gap.candidates import FREE_FORM
 from sim_gap.hypotheses import OUTSIDE
 from sim_gap.report import READABLE_SCHEMAS, SCHEMA
 from sim_gap.vocabulary import slip_band_labels
@@ -70,6 +71,8 @@ _LAW = re.compile(r"([a-z_]+?)(\d{4})(" + "|".join(map(re.escape, VARYING_TEXT))
 def law_text(law: str) -> str:
     """A law's key (``wong_kobayashi2012``) as its authors and year (Wong & Kobayashi 2012);
     a generalised law (``ding2011~load``) says so (Ding 2011, strength varying with load)."""
+    if law == FREE_FORM:
+        return "a shape none of its laws has: what differs between the levels"
     match = _LAW.fullmatch(law)
     if not match:
         return law

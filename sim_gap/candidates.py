@@ -131,6 +131,21 @@ def candidate(model: tm.WheelModel, effects: tuple[str, ...],
     return Candidate(effects, params, chosen)
 
 
+#: the law of an effect whose shape none of its laws has: a discrepancy apart per level of
+#: the factor the campaign sets for it (:data:`LEVEL_FACTOR`)
+FREE_FORM = "free_form"
+#: the column of the points that sets each level effect's factor
+LEVEL_FACTOR = {"multipass": "multipass", "reduced_gravity": "gravity_mps2",
+                "grousers": "source"}
+
+
+def with_free_form(c: Candidate, effect: str) -> Candidate:
+    """``c`` with ``effect`` added under :data:`FREE_FORM` (no parameter of its own)."""
+    order = list(tm.EFFECTS).index
+    pairs_ = sorted(zip(c.effects + (effect,), c.laws + (FREE_FORM,)), key=lambda x: order(x[0]))
+    return Candidate(tuple(e for e, _ in pairs_), c.params, tuple(law for _, law in pairs_))
+
+
 def singles(model: tm.WheelModel, laws: dict[str, tuple[str, ...]]) -> list[Candidate]:
     """Soil only, then each effect of ``laws`` alone under each of its laws."""
     return [candidate(model, ())] + [candidate(model, (e,), {e: law})

@@ -18,8 +18,10 @@ from sim_gap import candidates as cands
 from sim_gap.crossval import contrasts, cross_validate, folds
 from sim_gap.decide import by_effect, by_effect_set, decide, posterior
 from sim_gap.discriminate import separating_test
-from sim_gap.evidence import TAU_GRID, Evidence, log_evidence, observations
-from sim_gap.fit import MapFit, fit_map, quantities_of, sigmas, strengths, to_values
+from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances, log_evidence,
+                              observations)
+from sim_gap.fit import (MapFit, fit_map, internal_bounds, quantities_of, sigmas, strengths,
+                         to_values)
 from sim_gap.hypotheses import OUTSIDE, admissible, hypothesis_priors, param_prior
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
@@ -104,9 +106,12 @@ def _fit_all(sim, candidate_list, points, sig, settings, starts=None) -> dict[st
     return {c.key: f for c, f in zip(candidate_list, done)}
 
 
-def _evidence(obs, sim: Simulated, f: MapFit, outside=None) -> Evidence:
+def _evidence(cov, obs, sim: Simulated, f: MapFit) -> Evidence:
+    """The evidence of fit ``f`` with its prior truncated to its parameters' ranges."""
     centre, sd = param_prior(f.fit.candidate, sim.model)
-    return log_evidence(obs, f.predicted, f.jac, f.internal - centre, sd, outside)
+    lo, hi = internal_bounds(f.fit.candidate)
+    return log_evidence(cov, obs.y, f.predicted, f.jac, f.internal - centre, sd,
+                        (lo - centre, hi - centre))
 
 
 def _reference_laws(fits: dict[str, MapFit], evidence: dict[str, Evidence]) -> dict[str, str]:
@@ -140,6 +145,44 @@ def outside_amplitudes(sim: Simulated, points: pd.DataFrame, obs,
     sizes = [s for s in sizes if np.isfinite(s) and s > 0] or [float(TAU_GRID[-1])]
     lo, hi = max(0.5 * min(sizes), TAU_GRID[0]), max(2.0 * max(sizes), TAU_GRID[0])
     return np.geomspace(lo, max(hi, lo), 5)
+
+
+def _levels(points: pd.DataFrame, effect: str) -> np.ndarray | None:
+    """Per point, the level of the factor that sets ``effect`` (``cands.LEVEL_FACTOR``): the
+    multipass level, the gravity level, or the lugs of the source's wheel; None where the
+    points hold fewer than two levels."""
+    if effect == "grousers":
+        wheels = points.attrs.get("wheels") or {}
+        if "source" not in points or not wheels:
+            return None
+        levels = np.array([f"{w.grouser_count} x {w.grouser_height_m:g} m" if (
+            w := wheels.get(s)) else "unknown" for s in points["source"]])
+    else:
+        levels = points[cands.LEVEL_FACTOR[effect]].round(6).to_numpy()
+    return levels if len(set(levels.tolist())) >= 2 else None
+
+
+def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit],
+               reference: dict[str, str], amplitudes: np.ndarray
+               ) -> dict[str, tuple[cands.Candidate, MapFit, Evidence]]:
+    """Each level effect (multipass, reduced gravity, grousers with a sibling wheel) with a
+    shape none of its laws has: the discrepancy apart per level of its factor, sized as the
+    candidate effects are (``amplitudes``), on top of soil recalibration alone or with each
+    other effect under its reference law. An effect is what differs between the levels of
+    its factor, whatever its shape: "multipass, in a form the laws lack" is a member of the
+    multipass family, not an effect outside the candidates."""
+    out = {}
+    for effect in reference:
+        levels = _levels(points, effect) if effect in cands.LEVEL_FACTOR else None
+        if levels is None:
+            continue
+        cov = covariances(apart_by(obs, levels), amplitudes)
+        bases = [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()
+                                       if e != effect]
+        for base in bases:
+            c = cands.with_free_form(base.fit.candidate, effect)
+            out[c.key] = (c, base, _evidence(cov, obs, sim, base))
+    return out
 
 
 def _leading_sets(hypotheses: list[dict]) -> list[str]:
@@ -193,19 +236,25 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     fit_sig = _fit_noise(points, sig, sim.radius_m)
     single_list = cands.singles(sim.model, allowed)
     fits = _fit_all(sim, single_list, points, fit_sig, settings)
-    evidence = {k: _evidence(obs, sim, f) for k, f in fits.items()}
-    pairs = cands.pairs(sim.model, allowed, _reference_laws(fits, evidence))
+    cov = covariances(obs)
+    evidence = {k: _evidence(cov, obs, sim, f) for k, f in fits.items()}
+    reference = _reference_laws(fits, evidence)
+    pairs = cands.pairs(sim.model, allowed, reference)
     pair_fits = _fit_all(sim, pairs, points, fit_sig, settings,
                          [_pair_start(c, fits) for c in pairs])
-    evidence.update({k: _evidence(obs, sim, f) for k, f in pair_fits.items()})
+    evidence.update({k: _evidence(cov, obs, sim, f) for k, f in pair_fits.items()})
     fits.update(pair_fits)
-    evidence[OUTSIDE] = _evidence(obs, sim, fits["soil_only"],
-                                  outside_amplitudes(sim, points, obs, single_list))
-    prior = hypothesis_priors([f.fit.candidate for f in fits.values()], len(allowed))
+    candidate_of = {k: f.fit.candidate for k, f in fits.items()}
+    amplitudes = outside_amplitudes(sim, points, obs, single_list)
+    for key, (c, base, e) in free_forms(sim, points, obs, fits, reference, amplitudes).items():
+        candidate_of[key], fits[key], evidence[key] = c, base, e
+    evidence[OUTSIDE] = _evidence(covariances(obs, amplitudes), obs, sim, fits["soil_only"])
+    prior = hypothesis_priors(list(candidate_of.values()), len(allowed))
     probability = posterior({k: e.log_evidence for k, e in evidence.items()}, prior)
     hypotheses = sorted(
-        [_hypothesis(k, fits.get(k, fits["soil_only"]), evidence[k], prior[k], probability[k])
-         for k in evidence], key=lambda h: -h["probability"])
+        [_hypothesis(k, candidate_of.get(k), fits.get(k, fits["soil_only"]), evidence[k],
+                     prior[k], probability[k]) for k in evidence],
+        key=lambda h: -h["probability"])
     leaders = _leading_sets(hypotheses)
     separation = (_separation(sim, points, obs, fits, *leaders) if len(leaders) == 2 else None)
     decision = decide(hypotheses, separation)
@@ -291,8 +340,10 @@ def _noise_source(points: pd.DataFrame) -> dict[str, str]:
     return out
 
 
-def _hypothesis(key: str, f: MapFit, e: Evidence, prior: float, probability: float) -> dict:
-    c = f.fit.candidate
+def _hypothesis(key: str, c: cands.Candidate | None, f: MapFit, e: Evidence, prior: float,
+                probability: float) -> dict:
+    """One hypothesis of the report: candidate ``c`` (None: outside the candidates) with the
+    fit ``f`` its evidence rests on."""
     outside = key == OUTSIDE
     return {"key": key, "label": OUTSIDE if outside else c.label,
             "effects": [] if outside else list(c.effects),

@@ -27,7 +27,7 @@ carries (:data:`TAU_GRID`). A smooth error common to every source and level is d
 not evidence for an effect, whatever its size. The discrepancy is *shared*: one function of
 slip and load for every source, multipass level and gravity level, so an error common to
 sibling sources (a smooth and a lugged wheel on one soil) cancels in their contrast, which
-only an effect (or the hypothesis "outside the candidates", :func:`log_evidence`'s
+only an effect (or the hypothesis "outside the candidates", :func:`covariances`'
 ``outside``) can carry.
 
 The base model's error also has a part that is not smooth in slip and load: what differs
@@ -41,12 +41,12 @@ discrepancy cannot bend to is read as evidence for whichever effect bends the cu
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from scipy.linalg import cho_factor, cho_solve
-from scipy.special import logsumexp
+from scipy.linalg import cho_solve, cholesky, solve_triangular
+from scipy.special import log_ndtr, logsumexp
 
 from sim_gap.fit import quantities_of
 from sim_gap.vocabulary import model_error_floor
@@ -115,12 +115,51 @@ def observations(points: pd.DataFrame, sigma: dict[str, np.ndarray], radius_m: f
                         offsets)
 
 
-def _log_normal(r: np.ndarray, cov: np.ndarray) -> float:
-    """``log N(r; 0, cov)``."""
-    factor = cho_factor(cov, lower=True, check_finite=False)
-    alpha = cho_solve(factor, r, check_finite=False)
-    return float(-0.5 * r @ alpha - np.sum(np.log(np.diag(factor[0])))
-                 - 0.5 * r.size * np.log(2.0 * np.pi))
+def apart_by(obs: Observations, levels: np.ndarray) -> Observations:
+    """``obs`` whose second discrepancy is apart per value of ``levels`` (one per point: a
+    multipass level, a gravity level, a wheel) instead of per source and level."""
+    group = pd.factorize(pd.Series(list(levels), dtype=object))[0][obs.point]
+    same = group[:, None] == group[None, :]
+    return replace(obs, kernel_grouped=np.where(same, obs.kernel_shared, 0.0))
+
+
+@dataclass(frozen=True)
+class Covariances:
+    """The noise-plus-discrepancy covariance ``A`` of every grid point (shared amplitude x
+    outside amplitude x nugget), factored once for all candidates: ``lower`` Cholesky
+    factors (grid points, entries, entries) and ``log_det`` of each ``A``."""
+
+    lower: np.ndarray
+    log_det: np.ndarray
+    shape: tuple[int, int, int]
+
+
+def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covariances:
+    """Factor ``A = diag(sigma^2) + offsets + t^2 K_shared + o^2 K_grouped + v^2 diag(f^2)``
+    over :data:`TAU_GRID`, ``outside`` (amplitudes of the discrepancy apart per group, floor
+    units; none by default) and :data:`NUGGET_GRID`."""
+    outside = np.zeros(1) if outside is None else np.asarray(outside, float)
+    base = (np.diag(obs.sigma ** 2) + OFFSET_PRIOR_SD_M ** 2 * obs.offsets @ obs.offsets.T)
+    floor2 = np.diag(obs.floor ** 2)
+    lower, log_det = [], []
+    for t in TAU_GRID:
+        for o in outside:
+            for v in NUGGET_GRID:
+                factor = cholesky(base + t ** 2 * obs.kernel_shared + o ** 2 * obs.kernel_grouped
+                                  + v ** 2 * floor2, lower=True, check_finite=False)
+                lower.append(factor)
+                log_det.append(2.0 * np.sum(np.log(np.diag(factor))))
+    return Covariances(np.array(lower), np.array(log_det),
+                       (len(TAU_GRID), len(outside), len(NUGGET_GRID)))
+
+
+def _log_interval(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``log(Phi(b) - Phi(a))`` for ``a < b``, accurate in either tail."""
+    a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+    upper_tail = a > 0.0  # both in the upper tail: mirror them into the lower one
+    lo, hi = np.where(upper_tail, -b, a), np.where(upper_tail, -a, b)
+    log_hi, log_lo = log_ndtr(hi), log_ndtr(lo)
+    return log_hi + np.log1p(-np.exp(np.minimum(log_lo - log_hi, 0.0)))
 
 
 @dataclass(frozen=True)
@@ -137,25 +176,51 @@ class Evidence:
         return float(self.tau_weights @ TAU_GRID)
 
 
-def log_evidence(obs: Observations, predicted: np.ndarray, jac: np.ndarray,
+def log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np.ndarray,
                  offset_from_prior: np.ndarray, prior_sd: np.ndarray,
-                 outside: np.ndarray | None = None) -> Evidence:
+                 bounds_from_prior: tuple[np.ndarray, np.ndarray] | None = None) -> Evidence:
     """The linearised-Laplace log evidence of a candidate whose MAP predicts ``predicted``
-    (flat, the entries of ``obs``) with Jacobian ``jac`` (entries x parameters, internal
+    (flat, the entries ``y``) with Jacobian ``jac`` (entries x parameters, internal
     coordinates), ``offset_from_prior = u* - mu`` and prior standard deviations
-    ``prior_sd``; integrated over :data:`TAU_GRID` and :data:`NUGGET_GRID`. ``outside``:
-    amplitudes (floor units) of a second discrepancy apart per group (source, multipass,
-    gravity level), integrated log-uniformly too: the hypothesis that an effect outside the
-    candidates is at work."""
-    residual = obs.y - np.nan_to_num(predicted, nan=0.0) + jac @ offset_from_prior
-    base = (np.diag(obs.sigma ** 2) + (jac * prior_sd ** 2) @ jac.T
-            + OFFSET_PRIOR_SD_M ** 2 * obs.offsets @ obs.offsets.T)
-    outside = np.zeros(1) if outside is None else np.asarray(outside, float)
-    floor2 = np.diag(obs.floor ** 2)
-    grid = np.array([[[_log_normal(residual, base + t ** 2 * obs.kernel_shared
-                                   + o ** 2 * obs.kernel_grouped + v ** 2 * floor2)
-                       for v in NUGGET_GRID] for o in outside] for t in TAU_GRID])
-    logs = grid.reshape(len(TAU_GRID), -1) - np.log(grid.size)
+    ``prior_sd``, integrated over the grids of ``cov`` (:func:`covariances`).
+
+    With ``v = u - mu ~ N(0, S)`` the residual ``r = y - eta* + J (u* - mu) = J v + e``,
+    ``e ~ N(0, A)``, and by Woodbury's identity and the determinant lemma, with
+    ``M = S^-1 + J^T A^-1 J`` and ``b = J^T A^-1 r``::
+
+        log N(r; 0, A + J S J^T) = log N(r; 0, A) + b^T M^-1 b / 2 - log|S M| / 2
+
+    so each grid point needs only triangular solves with its factor of ``A``.
+
+    ``bounds_from_prior = (lower - mu, upper - mu)``: the parameters' ranges (a law's
+    declared range, the soil's plausible bounds). The prior is the Gaussian truncated to
+    that box, and for a model linear in ``u`` the evidence is exactly the untruncated one
+    times ``P_post(box) / P_prior(box)`` (the posterior ``N(M^-1 b, M^-1)``). Without that
+    factor an effect fitted at the end of its range (a bulldozing resistance of zero) would
+    be credited with the fit its Jacobian extrapolates to beyond it (a negative resistance,
+    pushing the wheel). The box probabilities are taken as products of the marginal ones
+    (exact for uncorrelated parameters; O'Hagan & Leonard 1976 for the one-sided case)."""
+    residual = y - np.nan_to_num(predicted, nan=0.0) + jac @ offset_from_prior
+    prior_var = prior_sd ** 2
+    rhs = np.column_stack([residual, jac])
+    logs = np.empty(cov.log_det.size)
+    for g, (factor, log_det) in enumerate(zip(cov.lower, cov.log_det)):
+        x = solve_triangular(factor, rhs, lower=True, check_finite=False)
+        xr, xj = x[:, 0], x[:, 1:]
+        b = xj.T @ xr
+        m = np.diag(1.0 / prior_var) + xj.T @ xj
+        m_factor = cholesky(m, lower=True, check_finite=False)
+        w = solve_triangular(m_factor, b, lower=True, check_finite=False)
+        logs[g] = (-0.5 * (xr @ xr - w @ w) - 0.5 * log_det
+                   - 0.5 * (np.sum(np.log(prior_var)) + 2.0 * np.sum(np.log(np.diag(
+                       m_factor)))) - 0.5 * residual.size * np.log(2.0 * np.pi))
+        if bounds_from_prior is not None:
+            post_cov = cho_solve((m_factor, True), np.eye(b.size), check_finite=False)
+            mean, sd = post_cov @ b, np.sqrt(np.diag(post_cov))
+            lo, hi = bounds_from_prior
+            logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)
+                              - _log_interval(lo / prior_sd, hi / prior_sd))
+    logs = logs.reshape(len(TAU_GRID), -1) - np.log(logs.size)
     total = float(logsumexp(logs))
     weights = np.exp(logsumexp(logs, axis=1) - total)
     return Evidence(total, weights)

@@ -95,6 +95,12 @@ def to_internal(c: Candidate, values: dict[str, float | str]) -> np.ndarray:
     return np.array([np.log(v) if p.log else v for p, v in zip(c.params, x)])
 
 
+def internal_bounds(c: Candidate) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of ``c``'s parameters in internal coordinates."""
+    return (np.array([np.log(p.lower) if p.log else p.lower for p in c.params]),
+            np.array([np.log(p.upper) if p.log else p.upper for p in c.params]))
+
+
 @dataclass(frozen=True)
 class FitResult:
     candidate: Candidate
@@ -112,8 +118,7 @@ def fit_candidate(sim: Simulated, c: Candidate, points: pd.DataFrame,
                   max_nfev: int = 40, loss: str = "soft_l1") -> FitResult:
     """Best parameters of ``c`` on ``points`` (``sigma``: the points' uncertainties;
     ``loss``: ``soft_l1`` (robust) or ``linear`` (plain least squares))."""
-    lo = np.array([np.log(p.lower) if p.log else p.lower for p in c.params])
-    hi = np.array([np.log(p.upper) if p.log else p.upper for p in c.params])
+    lo, hi = internal_bounds(c)
     u0 = to_internal(c, start) if start else to_internal(c, {p.name: p.start for p in c.params})
     u0 = np.clip(u0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
 
@@ -147,8 +152,7 @@ def fit_map(sim: Simulated, c: Candidate, points: pd.DataFrame, sigma: dict[str,
     stacked with one prior residual ``(u - centre)/sd`` per parameter (Gaussian likelihood
     and prior; MacKay 2003 ch. 27), bounded by the law's range."""
     centre, sd = prior
-    lo = np.array([np.log(p.lower) if p.log else p.lower for p in c.params])
-    hi = np.array([np.log(p.upper) if p.log else p.upper for p in c.params])
+    lo, hi = internal_bounds(c)
     u0 = to_internal(c, start) if start else to_internal(c, {p.name: p.start for p in c.params})
     u0 = np.clip(u0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
     residuals_at = residual_function(sim, points, sigma)

@@ -14,7 +14,7 @@ from sim_gap import candidates
 from sim_gap.decide import CALL_PROBABILITY, by_effect_set, decide, posterior
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.discriminate import separating_test
-from sim_gap.evidence import NUGGET_GRID, TAU_GRID, Observations, log_evidence
+from sim_gap.evidence import NUGGET_GRID, TAU_GRID, Observations, covariances, log_evidence
 from sim_gap.hypotheses import (OUTSIDE, P_EFFECT, admissible, hypothesis_priors,
                                 outside_prior, set_prior)
 from sim_gap.siblings import contrasts
@@ -62,7 +62,8 @@ def test_linearised_evidence_equals_the_integral_over_the_parameter():
     obs = Observations(y, sigma, floor, np.arange(8), np.zeros(8, int), np.ones((8, 1), bool),
                        kernel, np.zeros((8, 8)), np.zeros((8, 0)))
     mu, sd, a_hat = 1.0, 0.8, 1.5  # prior N(1, 0.8^2); expanded at a = 1.5 (any point)
-    got = log_evidence(obs, a_hat * x, x[:, None], np.array([a_hat - mu]), np.array([sd]))
+    got = log_evidence(covariances(obs), y, a_hat * x, x[:, None], np.array([a_hat - mu]),
+                       np.array([sd]))
 
     def integrand(a, tau, nugget):
         cov = np.diag(sigma ** 2 + (nugget * floor) ** 2) + tau ** 2 * kernel
@@ -72,6 +73,33 @@ def test_linearised_evidence_equals_the_integral_over_the_parameter():
                  for t in TAU_GRID for v in NUGGET_GRID])
     assert got.log_evidence == pytest.approx(np.log(z), abs=1e-6)
     assert got.tau_weights.sum() == pytest.approx(1.0)
+
+
+def test_evidence_integrates_only_over_the_parameters_range():
+    """A strength that cannot be negative (a resistance), data that slope downwards: the
+    evidence is the integral over the range only, with the prior renormalised to it
+    (quadrature), far below the untruncated one that credits a negative strength."""
+    rng = np.random.default_rng(4)
+    x = np.linspace(0.0, 1.0, 8)
+    sigma, floor = np.full(8, 0.3), np.full(8, 0.2)
+    y = -1.2 * x + rng.normal(0, 0.3, 8)
+    obs = Observations(y, sigma, floor, np.arange(8), np.zeros(8, int), np.ones((8, 1), bool),
+                       np.zeros((8, 8)), np.zeros((8, 8)), np.zeros((8, 0)))
+    mu, sd, lo, hi = 1.0, 0.5, 0.0, 2.0  # the law's range [0, 2] as +-2 sd
+    bounded = log_evidence(covariances(obs), y, 0.0 * x, x[:, None], np.array([lo - mu]),
+                           np.array([sd]), (np.array([lo - mu]), np.array([hi - mu])))
+    free = log_evidence(covariances(obs), y, 0.0 * x, x[:, None], np.array([lo - mu]),
+                        np.array([sd]))
+    prior_mass = stats.norm(mu, sd).cdf(hi) - stats.norm(mu, sd).cdf(lo)
+
+    def integrand(a, nugget):
+        cov = np.diag(sigma ** 2 + (nugget * floor) ** 2)
+        return (stats.multivariate_normal(a * x, cov).pdf(y) * stats.norm(mu, sd).pdf(a)
+                / prior_mass)
+
+    z = np.mean([integrate.quad(integrand, lo, hi, args=(v,))[0] for v in NUGGET_GRID])
+    assert bounded.log_evidence == pytest.approx(np.log(z), abs=1e-6)
+    assert free.log_evidence - bounded.log_evidence > 2.0
 
 
 def test_priors_sum_to_one_and_split_a_set_over_its_laws():
