@@ -1,5 +1,6 @@
 """The cores this process may run on: the default number of ``process`` jobs, the most
-threads softflow's kernels use, and each ``--jobs`` worker's (or dask task's) share of them."""
+threads softflow's kernels use, and each ``--jobs`` worker's (or dask task's) share of them.
+Counts only; a worker applies its share with ``swtlab.pipeline.process.limit_threads``."""
 
 from __future__ import annotations
 
@@ -20,18 +21,3 @@ def threads_per_worker(workers: int) -> int:
         raise ValueError(f"workers {workers} must be >= 1")
     return max(1, available_cores() // workers)
 
-
-def limit_threads(threads: int) -> None:
-    """Run this process's numba, OpenCV and BLAS/OpenMP on at most ``threads`` threads (each
-    ``jobs`` worker's initializer, and each dask task's, ``swtlab.cluster``: N workers each
-    with every core's threads oversubscribe the machine; numba's count is the calling
-    thread's). The libraries a run loads are imported first: threadpoolctl limits only those
-    loaded."""
-    from threadpoolctl import threadpool_limits
-
-    import ingest  # noqa: F401 - loaded before the limits, see above
-    import run_results.process  # noqa: F401
-    from softflow.threads import limit
-
-    limit(threads)
-    threadpool_limits(limits=threads)
