@@ -39,7 +39,7 @@ def _limits(_) -> dict:
             "blas": {i["filepath"]: i["num_threads"] for i in threadpool_info()}}
 
 
-@pytest.mark.parametrize("limit", [limit_threads, softflow_limit])
+@pytest.mark.parametrize("limit", [limit_threads, softflow_limit], ids=["runs", "frame_pairs"])
 def test_each_task_runs_on_its_share_of_its_hosts_cores(client, limit):
     """2 one-thread workers on this host: each task gets cores // 2 threads (1 on 2 cores),
     not the thread per core each library starts with; with the runs' limit (``swtlab
