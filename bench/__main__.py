@@ -15,7 +15,7 @@ import pkgutil
 from pathlib import Path
 
 import bench
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 
 
 def main() -> None:

@@ -19,7 +19,7 @@ import pandas as pd
 import terramechanics as tm
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.simulated import Simulated
-from swtlab.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
+from swtlab_base.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
 
 LOADS_N = (80.0, 140.0, 200.0, 260.0, 320.0)
 SLIPS = (0.1, 0.25, 0.4, 0.55, 0.7)

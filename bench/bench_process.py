@@ -29,7 +29,7 @@ from mcap.reader import make_reader
 
 import ingest
 from bench.bench_ingest import _campaign
-from swtlab.cores import threads_per_worker
+from swtlab_base.cores import threads_per_worker
 from swtlab.pipeline.process import ProcessSettings, process_file
 from swtlab_cli.main import main as swtlab
 

@@ -23,7 +23,7 @@ import numba
 import numpy as np
 
 from softflow.flow_engine import pair_displacement_px
-from swtlab.cores import available_cores
+from swtlab_base.cores import available_cores
 from virtual_testbed.flow_render import FlowScene, render_flow
 
 REPEATS = 5

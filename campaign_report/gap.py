@@ -35,8 +35,8 @@ from sim_gap.candidates import FREE_FORM
 from sim_gap.hypotheses import OUTSIDE
 from sim_gap.report import READABLE_SCHEMAS, SCHEMA
 from sim_gap.vocabulary import slip_band_labels
-from swtlab.atomic import write_atomically
-from swtlab.rounding import to_decimal_of
+from swtlab_base.atomic import write_atomically
+from swtlab_base.rounding import to_decimal_of
 from terramechanics.effects.depth_varying import SUFFIX as DEPTH_VARYING
 from terramechanics.effects.load_varying import SUFFIX as LOAD_VARYING
 from terramechanics.effects.lug_slip_sinkage import SUFFIX as LUG_SLIP_SINKAGE
@@ -347,7 +347,7 @@ def _number(quantity, si_value: float | None) -> str:
 
 def _shrink(v: dict) -> tuple[str, str]:
     """The shrink and its 95 % interval, both to the decimal the interval's half-width (its
-    expanded uncertainty, two significant digits) supports (GUM 7.2.6; ``swtlab.rounding``)."""
+    expanded uncertainty, two significant digits) supports (GUM 7.2.6; ``swtlab_base.rounding``)."""
     low, high = v["shrink_pct_ci95"]
     if low is None or high is None:
         return to_decimal_of(v["shrink_pct"], None), ""

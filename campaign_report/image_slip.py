@@ -15,7 +15,7 @@ from campaign_report.extensions import Extension, register
 from campaign_report.html import Image, Note, Section, Table
 from campaign_report.images import to_png
 from campaign_report.style import Palette
-from swtlab.rounding import value_and_u
+from swtlab_base.rounding import value_and_u
 
 #: the agreement the RUAG campaign reports between photo and facility slip
 AGREEMENT = 0.01

@@ -17,7 +17,7 @@ from campaign_report.extensions import optional_sections
 from campaign_report.html import Page, render_page
 from campaign_report.images import RENDER_RC
 from campaign_report.style import Palette
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 from traceability import open_database
 from traceability.provenance import swtlab_version
 

@@ -1,5 +1,5 @@
 """The campaign page's replicate section, right after the run table: the spread of runs of
-one test condition beside their within-run uncertainty (``swtlab.domain.replicates``), or
+one test condition beside their within-run uncertainty (``swtlab_base.domain.replicates``), or
 the note that the campaign has no replicates."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import math
 from campaign_report.data import CampaignData
 from campaign_report.html import Note, Section, Table
 from campaign_report.style import QUANTITIES, Palette, Quantity
-from swtlab.domain.replicates import NO_REPLICATES, replicate_spread
-from swtlab.rounding import to_decimal_of, value_and_u
+from swtlab_base.domain.replicates import NO_REPLICATES, replicate_spread
+from swtlab_base.rounding import to_decimal_of, value_and_u
 
 
 def _slip(value) -> str:

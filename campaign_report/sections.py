@@ -13,8 +13,8 @@ from campaign_report.html import Drawing, Heading, Image, Note, Section, Table
 from campaign_report.images import to_png
 from campaign_report.style import CURVE_QUANTITIES, QUANTITIES, Palette
 from run_results.traces import MAX_TRACE_POINTS
-from swtlab.rounding import plain, value_and_u
-from swtlab.domain.results import not_measured_heads
+from swtlab_base.rounding import plain, value_and_u
+from swtlab_base.domain.results import not_measured_heads
 from wpm_export import WheelPerformanceModule
 
 RUNS = "runs"
@@ -41,7 +41,7 @@ TABLE_QUANTITIES = (("slip", "slip", "%", 100.0, 3), ("dp_n", "DP", "N", 1.0, 4)
 
 def _mean_and_u(run: RunRecord, key: str, scale: float, digits: int) -> list[str]:
     """A quantity's mean and its combined standard uncertainty, u to two significant digits
-    and the mean to the same decimal (``swtlab.rounding``); without a budget the mean to
+    and the mean to the same decimal (``swtlab_base.rounding``); without a budget the mean to
     ``digits`` significant digits and u empty."""
     mean, u = run.means.get(key), run.u.get(key)
     if u is None:

@@ -11,7 +11,7 @@ import pandas as pd
 from fitting.curve import QUANTITY_UNITS, CurveFit
 from fitting.errors import FittingError, TooFewPointsError
 from fitting.fit import check_degree, fit_curve
-from swtlab.domain.replicates import fit_sigma
+from swtlab_base.domain.replicates import fit_sigma
 
 KEY_COLUMNS = ("wheel", "soil", "multipass", "load_n")
 MEASURED = ("dp_n", "torque_nm", "sinkage_m", "resistance_n")
@@ -26,7 +26,7 @@ def from_run_results(results: pd.DataFrame, statuses: Iterable[str] = ("ok",)) -
     (default: ``ok``) and that are not steered. Other columns (``run_id``,
     ``raw_file_sha256`` ...) are kept for the trace. ``<q>_se`` becomes the fit's sigma of
     each run: the larger of its uncertainty (``<q>_u`` of the budget, else its SE) and the
-    spread of its replicates (``swtlab.domain.replicates.fit_sigma``)."""
+    spread of its replicates (``swtlab_base.domain.replicates.fit_sigma``)."""
     keep = results["status"].isin(list(statuses))
     if "mode" in results:
         keep &= results["mode"] != "steered"

@@ -11,7 +11,7 @@ import pandas as pd
 from ingest.errors import IngestError
 from ingest.raw import RawTopic
 from ingest.units import column_quantity
-from swtlab.domain.ranges import CHANNEL_LIMITS, COLUMN_LIMITS
+from swtlab_base.domain.ranges import CHANNEL_LIMITS, COLUMN_LIMITS
 
 
 def check_topic(path: Path, topic: str, raw: RawTopic) -> None:
@@ -74,7 +74,7 @@ def numeric_column(path: Path, frame: pd.DataFrame, column: str, first_row: int)
 
 def check_calibrated(path: Path, where: str, column: str, values: np.ndarray) -> None:
     """A channel after calibration and zeroing: every sample finite and within the
-    magnitude its quantity (or column) can have on a testbed (``swtlab.domain.ranges``);
+    magnitude its quantity (or column) can have on a testbed (``swtlab_base.domain.ranges``);
     beyond it the gain, offset, zero or unit is wrong."""
     peak = float(np.max(np.abs(values))) if values.size else 0.0  # NaN or inf: some are
     if not math.isfinite(peak):

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from scipy.signal import savgol_filter
 
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 #: relative error aimed at for a derivative at the stream's typical speed
 TARGET_REL_ERROR = 0.01

@@ -1,15 +1,14 @@
 """Which reader a run needs, by its content (magic bytes), not only by its extension.
 
-``sniff`` names the format; ``read_raw_file`` hands the path to that format's reader.
+``sniff`` names the format; ``ingest.run.read_raw_file`` hands the path to that format's
+reader (there, so that the readers may use the names here: imports point one way).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from ingest.channel_map import ChannelMap
 from ingest.errors import IngestError
-from ingest.raw import RawRun
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
@@ -85,30 +84,3 @@ def _mcap_is_cdr(path: Path) -> bool:
         return False
     return any(c.message_encoding == "cdr" for c in summary.channels.values())
 
-
-def read_raw_file(path: Path, cmap: ChannelMap) -> RawRun:
-    """Read ``path`` with the reader of its sniffed format (named in the raw run's ``form``)."""
-    fmt = sniff(path)
-    raw = _read(path, cmap, fmt)
-    raw.form = fmt
-    return raw
-
-
-def _read(path: Path, cmap: ChannelMap, fmt: str) -> RawRun:
-    if fmt == "mcap":
-        from ingest.mcap_reader import read_mcap
-        return read_mcap(path, set(cmap.topics))
-    if fmt == "csv_run":
-        from ingest.csv_reader import read_csv_run
-        return read_csv_run(path, cmap)
-    if fmt == "hdf5":
-        from ingest.hdf5_reader import read_hdf5
-        return read_hdf5(path, cmap)
-    if fmt in ("mat5", "mat73"):
-        from ingest.mat_reader import read_mat
-        return read_mat(path, cmap, fmt)
-    if fmt == "tdms":
-        from ingest.tdms_reader import read_tdms
-        return read_tdms(path, cmap)
-    from ingest.ros_reader import read_ros
-    return read_ros(path, cmap)

@@ -6,7 +6,7 @@ import numpy as np
 
 from ingest.canonical import STABLE_PHASE_NEEDS
 from ingest.run import Run
-from plain_json import jsonable
+from swtlab_base.plain_json import jsonable
 
 _DERIVED_UNITS = {"slip": "1"}
 

@@ -13,8 +13,8 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ingest.errors import IngestError, Problem
-from swtlab.domain import G0_MPS2, MODES, Wheel
-from swtlab.domain.ranges import METADATA
+from swtlab_base.domain import G0_MPS2, MODES, Wheel
+from swtlab_base.domain.ranges import METADATA
 
 #: longest text of a bad value an error message quotes
 MAX_SHOWN_CHARS = 40
@@ -329,7 +329,7 @@ def parse_metadata(path: Path, records: Mapping[str, Mapping[str, Any]],
 
 
 def _check_ranges(path: Path, metadata: RunMetadata) -> None:
-    """Every number of the typed metadata within its possible range (``swtlab.domain.ranges``;
+    """Every number of the typed metadata within its possible range (``swtlab_base.domain.ranges``;
     outside it no testbed could have measured the run)."""
     values = {f"{record}.{key}": value for record in ("run", "wheel", "suspension", "camera",
                                                       "camera_track")

@@ -15,7 +15,7 @@ from ingest.channel_map import ChannelMap, ChannelSpec, load_channel_map
 from ingest.checks import check_calibrated, check_topic
 from ingest.delimited_reader import read_delimited
 from ingest.errors import IngestError, Problem
-from ingest.formats import is_ros_bag, read_raw_file
+from ingest.formats import is_ros_bag, sniff
 from ingest.metadata import RunMetadata, parse_metadata
 from ingest.raw import FrameIndex, RawRun
 from ingest.records import merged_records, metadata_form
@@ -118,6 +118,34 @@ def _read_raw(path: Path, cmap: ChannelMap) -> RawRun:
         raw.form = "delimited"
         return raw
     return read_raw_file(path, cmap)
+
+
+def read_raw_file(path: Path, cmap: ChannelMap) -> RawRun:
+    """Read ``path`` with the reader of its sniffed format (named in the raw run's ``form``)."""
+    fmt = sniff(path)
+    raw = _read(path, cmap, fmt)
+    raw.form = fmt
+    return raw
+
+
+def _read(path: Path, cmap: ChannelMap, fmt: str) -> RawRun:
+    if fmt == "mcap":
+        from ingest.mcap_reader import read_mcap
+        return read_mcap(path, set(cmap.topics))
+    if fmt == "csv_run":
+        from ingest.csv_reader import read_csv_run
+        return read_csv_run(path, cmap)
+    if fmt == "hdf5":
+        from ingest.hdf5_reader import read_hdf5
+        return read_hdf5(path, cmap)
+    if fmt in ("mat5", "mat73"):
+        from ingest.mat_reader import read_mat
+        return read_mat(path, cmap, fmt)
+    if fmt == "tdms":
+        from ingest.tdms_reader import read_tdms
+        return read_tdms(path, cmap)
+    from ingest.ros_reader import read_ros
+    return read_ros(path, cmap)
 
 
 def _coverage_problems(path: Path, raw: RawRun, cmap: ChannelMap) -> list[Problem]:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swtlab.order_stats import median as _median
+from swtlab_base.order_stats import median as _median
 
 #: an interval longer than GAP_FACTOR median intervals is a gap (no interpolation across it)
 GAP_FACTOR = 5.0

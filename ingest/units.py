@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swtlab.domain.gravity import G0_MPS2
+from swtlab_base.domain.gravity import G0_MPS2
 
 
 @dataclass(frozen=True)

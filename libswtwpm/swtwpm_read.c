@@ -883,7 +883,7 @@ static int json_value(json_reader *r, json *v, int depth)
     return 1;
 }
 
-/* Validate one wheel's geometry as swtlab.domain.Wheel; 0 or a format error. */
+/* Validate one wheel's geometry as swtlab_base.domain.Wheel; 0 or a format error. */
 static int wheel_values(const context_t *ctx, const char *name, const json *entry,
                         double geometry[5])
 {

@@ -12,8 +12,8 @@ import numpy as np
 import pandas as pd
 
 from run_results.result import RunResult
-from swtlab.domain.replicates import with_repeatability
-from swtlab.domain.results import (COLUMNS, WHEEL_COLUMNS, budget_columns, check_results,
+from swtlab_base.domain.replicates import with_repeatability
+from swtlab_base.domain.results import (COLUMNS, WHEEL_COLUMNS, budget_columns, check_results,
                                    not_measured_text)
 
 
@@ -21,7 +21,7 @@ GROUP = ["wheel", "soil", "multipass", "load_set_n"]
 
 
 def results_row(r: RunResult) -> dict:
-    """One run's row of the results table (``swtlab.domain.results``, docs/results.md)."""
+    """One run's row of the results table (``swtlab_base.domain.results``, docs/results.md)."""
     c, w = r.condition, r.window
     row = {"campaign": c["campaign"], "run_id": r.run_id,
            **{k: c[k] for k in ("wheel", *WHEEL_COLUMNS, "soil")},
@@ -42,7 +42,7 @@ def results_row(r: RunResult) -> dict:
 
 def results_table(results: list[RunResult]) -> pd.DataFrame:
     """Run results as the one-row-per-run table of ``swtlab results`` (docs/results.md), for
-    code without a database; checked against the schema (``swtlab.domain.check_results``)."""
+    code without a database; checked against the schema (``swtlab_base.domain.check_results``)."""
     table = pd.DataFrame.from_records([results_row(r) for r in results],
                                       columns=None if results else list(COLUMNS))
     return check_results(with_repeatability(table))

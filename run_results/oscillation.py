@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 HARMONICS = 6
 SEARCH_RATIO = 0.4   # look for the frequency within +-40 % of the expected one

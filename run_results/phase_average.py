@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 MIN_BINS, MAX_BINS = 4, 256
 

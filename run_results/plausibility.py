@@ -13,7 +13,7 @@ window statistics: each check that fails is a flag with its reason (the run's st
   drawbar pull or thrust beyond any soil's traction, sinkage deeper than the wheel radius;
 - the measured wheel load against the set load beyond :data:`LOAD_REL_TOL`;
 - a speed that missed its set point (the gate held the run to its own plateau instead);
-- metadata outside the plausible ranges of ``swtlab.domain.ranges`` (wheel radius, width,
+- metadata outside the plausible ranges of ``swtlab_base.domain.ranges`` (wheel radius, width,
   stiffness, grouser count and height, set load, gravity);
 - dig-in: the drawbar pull rose to a peak after the speeds reached their set points and
   collapsed before the window (slip sinkage at high slip: Ding et al. 2011, J.
@@ -30,8 +30,8 @@ import numpy as np
 from ingest.canonical import WRENCH_COLUMNS
 from run_results.native import channel_samples, hub_samples
 from stable_phase.signals import grouser_period_s, moving_average
-from swtlab.domain.ranges import METADATA, WHEEL_KEYS
-from swtlab.order_stats import median
+from swtlab_base.domain.ranges import METADATA, WHEEL_KEYS
+from swtlab_base.order_stats import median
 
 #: force and torque channels checked for saturation
 RAIL_CHANNELS = (*WRENCH_COLUMNS.values(), "dp_n")

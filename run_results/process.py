@@ -37,8 +37,8 @@ from run_results.traces import run_traces
 from run_results.uncertainty_budget import BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
-from swtlab.domain.results import wheel_columns
-from swtlab.order_stats import median
+from swtlab_base.domain.results import wheel_columns
+from swtlab_base.order_stats import median
 
 #: quantities from the window's displacements (``run_results.rates``)
 RATES = ("slip", "travel_velocity_mps", "wheel_omega_radps")

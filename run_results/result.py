@@ -7,8 +7,8 @@ from dataclasses import dataclass, field
 from run_results.stats import QuantityStats
 from run_results.traces import Trace
 from stable_phase import StableWindow
-from plain_json import jsonable
-from swtlab.domain.results import STATUSES
+from swtlab_base.plain_json import jsonable
+from swtlab_base.domain.results import STATUSES
 
 
 @dataclass(frozen=True)

@@ -77,8 +77,8 @@ from run_results.native import MIN_SAMPLES_PER_BIN, channel_samples, hub_samples
 from run_results.phase_average import phase_average
 from run_results.rest_readings import RestReadings, quantisation_u, resolution
 from run_results.stats import PitchBatches, QuantityStats
-from swtlab.domain.results import UNCERTAINTY_TERMS as TERMS
-from swtlab.order_stats import median
+from swtlab_base.domain.results import UNCERTAINTY_TERMS as TERMS
+from swtlab_base.order_stats import median
 
 #: quantity -> (load-cell column, divide by the wheel radius?) for the single-cell quantities
 CELL_OF = {"dp_n": ("dp_n", False), "torque_nm": ("ty_nm", False),

@@ -28,7 +28,7 @@ from sim_gap.shrink import shrink
 from sim_gap.siblings import contrasts as sibling_contrasts
 from sim_gap.simulated import Simulated
 from sim_gap.vocabulary import model_error_floor
-from swtlab.domain.gravity import G0_MPS2
+from swtlab_base.domain.gravity import G0_MPS2
 
 #: a standardised prediction change below this (max over points) makes an effect untestable
 TESTABLE_SIGMA = 0.2

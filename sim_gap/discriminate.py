@@ -11,7 +11,7 @@ from sim_gap.fit import quantities_of
 from sim_gap.points_csv import WHEEL_KEY
 from sim_gap.simulated import Simulated
 from sim_gap.vocabulary import model_error_floor
-from swtlab.domain.gravity import MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2
+from swtlab_base.domain.gravity import MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2
 
 #: gravity levels proposed when a campaign has only one: Mars and the Moon
 PROPOSED_GRAVITY_MPS2 = (MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2)

@@ -24,8 +24,8 @@ from fitting.polynomial import curve_value
 from fitting.table import from_run_results
 from sim_gap.points_csv import WHEEL_KEY, is_points_csv, read_points_csv, wheel_of
 from sim_gap.vocabulary import QUANTITIES
-from swtlab.domain import G0_MPS2, Wheel, check_results, wheels_of
-from swtlab.domain.replicates import replicate_spread
+from swtlab_base.domain import G0_MPS2, Wheel, check_results, wheels_of
+from swtlab_base.domain.replicates import replicate_spread
 from wpm_export import WheelPerformanceModule
 
 #: the wheel of the CMU smooth runs: the shipped channel map's swt.wheel

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from sim_gap.vocabulary import QUANTITIES
-from swtlab.domain import G0_MPS2, Wheel
+from swtlab_base.domain import G0_MPS2, Wheel
 
 #: columns every points CSV has
 REQUIRED = ("source", "wheel_radius_m", "wheel_width_m", "load_set_n", "slip")

@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from plain_json import jsonable
-from swtlab.atomic import write_atomically
+from swtlab_base.plain_json import jsonable
+from swtlab_base.atomic import write_atomically
 
 SCHEMA = "swtlab.gap-report/2"
 #: the schemas :mod:`campaign_report.gap` still reads

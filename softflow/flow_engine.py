@@ -334,17 +334,18 @@ def _pair_flows(frames: list[np.ndarray], soil_masks: list[np.ndarray], engine: 
     """:func:`pair_displacement_px` of each consecutive pair (fixed window
     ``RATE_KERNELS_PX``, frames smoothed by ``RATE_PRESMOOTH_PX``) in pair order: here, or on
     the workers of the ``dask.distributed`` ``client`` (each frame sent once;
-    ``swtlab.cluster.map_in_order``)."""
+    ``swtlab_base.cluster.map_in_order``)."""
     n = len(frames) - 1
     if client is None:
         return (pair_displacement_px(frames[k], frames[k + 1], engine, soil_masks[k],
                                      RATE_KERNELS_PX, RATE_PRESMOOTH_PX) for k in range(n))
-    from swtlab.cluster import map_in_order
+    from softflow.threads import limit
+    from swtlab_base.cluster import map_in_order
 
     sent = client.scatter(list(frames))
     return map_in_order(client, pair_displacement_px, sent[:-1], sent[1:], [engine] * n,
                         client.scatter(list(soil_masks[:n])), [RATE_KERNELS_PX] * n,
-                        [RATE_PRESMOOTH_PX] * n)
+                        [RATE_PRESMOOTH_PX] * n, limit=limit)
 
 
 def average_flow(frames: list[np.ndarray], t_s: np.ndarray, soil_masks: list[np.ndarray],

@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from softflow.flow_result import FlowResult
-from swtlab.atomic import atomic_file
+from swtlab_base.atomic import atomic_file
 
 
 def magnitude_map(result: FlowResult, frame: np.ndarray):

@@ -5,10 +5,11 @@ machine's CPUs; a process pinned later (``taskset``, ``os.sched_setaffinity``, a
 worker given fewer cores) would run more threads than it has cores, and a parallel loop is
 only as fast as its slowest thread (issue 19 item 6: on a busy 2-core machine, 2 threads
 took 2.4x the time of one). :func:`capped` runs a function with numba's and OpenCV's
-threads at most ``swtlab.cores.available_cores()`` (never more than the caller set), and
-restores them after; :func:`limit` sets them for the rest of the process (a ``swtlab
-process --jobs`` worker's share of the cores). The results do not depend on the thread
-count (every parallel loop writes its own rows).
+threads at most ``swtlab_base.cores.available_cores()`` (never more than the caller set),
+and restores them after; :func:`limit` sets them, and the loaded BLAS/OpenMP libraries',
+for the rest of the process (a ``swtlab process --jobs`` worker's or a dask task's share of
+the cores). The results do not depend on the thread count (every parallel loop writes its
+own rows).
 """
 
 from __future__ import annotations
@@ -17,20 +18,23 @@ import contextlib
 import functools
 
 import cv2
+from threadpoolctl import threadpool_limits
 
 from softflow.numba_layer import numba
-from swtlab.cores import available_cores
+from swtlab_base.cores import available_cores
 
 
 def limit(threads: int) -> None:
-    """numba and OpenCV on at most ``threads`` threads in this process from now on (numba's
-    count is per calling thread: call it from the thread that runs the kernels). softflow's
-    import has chosen numba's fork-safe workqueue layer before this starts its threads.
-    OpenCV's count is left as it is when it is ``threads`` already (inherited, see
+    """numba, OpenCV and the BLAS/OpenMP libraries loaded so far (threadpoolctl limits only
+    those) on at most ``threads`` threads in this process from now on (numba's count is per
+    calling thread: call it from the thread that runs the kernels). softflow's import has
+    chosen numba's fork-safe workqueue layer before this starts its threads. OpenCV's count
+    is left as it is when it is ``threads`` already (inherited, see
     :func:`opencv_threads`)."""
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     if cv2.getNumThreads() != max(1, threads):
         cv2.setNumThreads(max(1, threads))
+    threadpool_limits(limits=threads)
 
 
 @contextlib.contextmanager

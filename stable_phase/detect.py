@@ -25,7 +25,7 @@ from stable_phase.params import StablePhaseParams
 from stable_phase.registry import get_detector
 from stable_phase.signals import grouser_period_s, moving_average
 from stable_phase.window import StableWindow
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 #: signals the transient cut looks at, in order of preference, and those the checks test
 SETTLING = ("hub_height_m", "sinkage_m", "dp_n", "ty_nm")

@@ -28,7 +28,7 @@ import numpy as np
 
 from stable_phase.params import StablePhaseParams
 from stable_phase.signals import longest_true_run, moving_average, robust_sigma
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,7 @@ import numpy as np
 
 from stable_phase.registry import Cut, register
 from stable_phase.signals import moving_average
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 
 def batch_means(t_s: np.ndarray, y: np.ndarray, period_s: float | None,

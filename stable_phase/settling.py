@@ -29,7 +29,7 @@ from scipy.optimize import curve_fit
 from stable_phase.mser import MserDetector, batch_means, mser_two_sided
 from stable_phase.registry import Cut, register
 from stable_phase.signals import moving_average
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 MIN_SNR = 10.0
 #: the smoothed signals are fitted on at most this many points (decimated after the

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 
 def moving_average(x, width: int, full_only: bool = False, at=None) -> np.ndarray:

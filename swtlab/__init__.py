@@ -1,26 +1,16 @@
-"""swtlab's front door (docs/python-api.md): the domain model (:mod:`swtlab.domain`) and the
-pipeline API (:mod:`swtlab.pipeline`)::
+"""swtlab's front door (docs/python-api.md): the pipeline API (:mod:`swtlab.pipeline`)::
 
     import swtlab
     campaign = swtlab.process_campaign("sample_data/campaign")
     curves = swtlab.fit_curves(campaign)
     swtlab.export_wpm(curves, "wpm.csv")
 
-The API names are loaded on first use, so that a stage importing :mod:`swtlab.domain` does
-not import every other stage.
+The top layer: it chains the stages, and no stage imports it (the domain model every stage
+shares is :mod:`swtlab_base.domain`).
 """
 
-from __future__ import annotations
+from swtlab.pipeline import (Campaign, Curves, GapReport, diagnose_gap, export_wpm,
+                             fit_curves, load, process_campaign, read_wpm, report, store)
 
-import importlib
-
-API = ("Campaign", "Curves", "GapReport", "process_campaign", "fit_curves", "export_wpm",
-       "read_wpm", "diagnose_gap", "store", "load", "report")
-
-__all__ = list(API)
-
-
-def __getattr__(name: str):
-    if name in API:
-        return getattr(importlib.import_module("swtlab.pipeline"), name)
-    raise AttributeError(f"module 'swtlab' has no attribute {name!r}")
+__all__ = ["Campaign", "Curves", "GapReport", "diagnose_gap", "export_wpm", "fit_curves", "load",
+           "process_campaign", "read_wpm", "report", "store"]

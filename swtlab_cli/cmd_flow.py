@@ -8,7 +8,7 @@ import sys
 
 from swtlab_cli import exit_codes
 from swtlab_cli.flags import as_flags
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 
 ENGINE_CHOICES = ("deform-lk", "farneback", "dis")  # softflow.flow_engine.ENGINES, kept light
 
@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     from softflow.flow_checks import FlowMeasurementError
     from softflow.frames import FrameSourceError, load_frames
     from softflow.wheel_detect import WheelNotFoundError
-    from swtlab.cluster import connect
+    from swtlab_base.cluster import connect
 
     try:
         client = connect(args.dask) if args.dask else None

@@ -11,7 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from swtlab_cli import exit_codes
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
               "installed with swtlab; run it from a swtlab repository checkout "
               "(pip install -e .)")
         return exit_codes.USAGE
-    from swtlab.cluster import connect
+    from swtlab_base.cluster import connect
     from validation.gap_bench import FAST_DESIGN, Design, format_score, run_bench
 
     if args.n < 1:

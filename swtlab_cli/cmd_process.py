@@ -99,8 +99,8 @@ def _where(db: str) -> str:
 def run(args: argparse.Namespace) -> int:
     import ingest
     from swtlab.pipeline.database import store_one
-    from swtlab.cluster import connect
-    from swtlab.cores import available_cores
+    from swtlab_base.cluster import connect
+    from swtlab_base.cores import available_cores
     from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
                                          process_files, rig_compliance)
     from traceability import open_database

@@ -10,8 +10,8 @@ from pathlib import Path
 import pandas as pd
 
 from swtlab_cli import exit_codes
-from swtlab.atomic import atomic_file
-from swtlab.domain.results import not_measured_heads
+from swtlab_base.atomic import atomic_file
+from swtlab_base.domain.results import not_measured_heads
 
 SUMMARY_COLUMNS = ["run_id", "mode", "load_set_n", "multipass", "slip_setpoint", "status",
                    "window_start_s", "window_end_s", "slip_mean", "slip_u95", "dp_n_mean",
@@ -78,9 +78,9 @@ REPLICATE_U = {"mean": "within_u", "replicate_sd": "replicate_sd", "within_u": "
 
 def shown(frame: pd.DataFrame, uncertainty: dict[str, str]) -> pd.DataFrame:
     """``frame`` as text for a person: each value of ``uncertainty``'s keys to the decimal of
-    its row's uncertainty column (two significant digits; ``swtlab.rounding``), the
+    its row's uncertainty column (two significant digits; ``swtlab_base.rounding``), the
     uncertainty columns to two significant digits, other numbers to four, NaN empty."""
-    from swtlab.rounding import plain, value_and_u
+    from swtlab_base.rounding import plain, value_and_u
 
     us = set(uncertainty.values())
     out = {}
@@ -134,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
             return exit_codes.BAD_INPUT
         failed = failed.iloc[0:0]
     if args.replicates:
-        from swtlab.domain.replicates import NO_REPLICATES, replicate_spread
+        from swtlab_base.domain.replicates import NO_REPLICATES, replicate_spread
 
         table = replicate_spread(table) if len(table) else table
         if table.empty:

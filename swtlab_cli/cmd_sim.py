@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from swtlab_cli import exit_codes
-from swtlab.atomic import atomic_file
+from swtlab_base.atomic import atomic_file
 
 COLUMNS = ["load_n", "multipass", "gravity_mps2", "slip", "dp_n", "torque_nm", "sinkage_m",
            "resistance_n", "thrust_n", "compaction_resistance_n", "fz_n", "fz_residual_n",

@@ -6,7 +6,7 @@ import dataclasses
 import tomllib
 from pathlib import Path
 
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 from terramechanics.effects import EFFECTS, make_effect
 from terramechanics.model import WheelModel
 from terramechanics.soil import SOILS, SoilParams

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from swtlab.domain.gravity import G0_MPS2
+from swtlab_base.domain.gravity import G0_MPS2
 
 #: the gravity the soil parameters hold at (their unit weight rho g): standard gravity
 EARTH_GRAVITY_MPS2 = G0_MPS2

@@ -1,4 +1,4 @@
-"""Output files are written whole or not at all (issue 17, item 6; ``swtlab.atomic``): a writer
+"""Output files are written whole or not at all (issue 17, item 6; ``swtlab_base.atomic``): a writer
 killed mid-write or failing before the rename leaves the old file, and the database records an
 export's sha256 only once the file is in place."""
 
@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 from sqlalchemy import func, select
 
-import swtlab.atomic
-from swtlab.atomic import atomic_file, write_atomically
+import swtlab_base.atomic
+from swtlab_base.atomic import atomic_file, write_atomically
 from swtlab_cli import exit_codes
 from swtlab_cli.main import main
 from traceability import open_database
@@ -28,7 +28,7 @@ OLD = b"time_s,dp_n\n0,1\n"
 #: a child that writes 1 MiB blocks slowly through atomic_file, saying when 8 MiB are written
 SLOW_WRITER = """
 import sys, time
-from swtlab.atomic import atomic_file
+from swtlab_base.atomic import atomic_file
 with atomic_file(sys.argv[1], "wb") as stream:
     for i in range(100_000):
         stream.write(b"n" * (1 << 20))
@@ -66,7 +66,7 @@ def test_failure_between_write_and_rename_keeps_the_old_file(tmp_path, monkeypat
     target = tmp_path / "out.csv"
     target.write_bytes(OLD)
 
-    monkeypatch.setattr(swtlab.atomic.os, "replace", _no_rename)
+    monkeypatch.setattr(swtlab_base.atomic.os, "replace", _no_rename)
     with pytest.raises(OSError, match="No space"):
         if writer == "bytes":
             write_atomically(target, b"new content\n" * 1000)
@@ -106,7 +106,7 @@ def test_export_hash_is_recorded_only_after_the_rename(tmp_path, monkeypatch, ca
     with open_database(db, read_only=True)() as session:
         recorded = session.scalars(select(WpmExport.file_sha256)).all()
     assert recorded == [hashlib.sha256(first).hexdigest()]
-    monkeypatch.setattr(swtlab.atomic.os, "replace", _no_rename)
+    monkeypatch.setattr(swtlab_base.atomic.os, "replace", _no_rename)
     capsys.readouterr()
     assert main(["export", "--db", db, "-o", str(wpm), "--degree", "4"]) == exit_codes.BAD_INPUT
     assert "cannot write" in capsys.readouterr().err

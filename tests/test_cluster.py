@@ -1,4 +1,4 @@
-"""swtlab.cluster on a real two-worker ``dask.distributed.LocalCluster``: each task runs
+"""swtlab_base.cluster on a real two-worker ``dask.distributed.LocalCluster``: each task runs
 numba, OpenCV and BLAS on its share of its host's cores; ``swtlab flow --dask`` (frame
 pairs) on the cluster gives the numbers of the local run (the gap bench's campaigns on the
 cluster: tests/test_gap_bench.py)."""
@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 from softflow.field_analysis import analyse_frames
-from swtlab.cluster import map_in_order, task_slots
+from softflow.threads import limit as softflow_limit
+from swtlab.pipeline.process import limit_threads
+from swtlab_base.cluster import map_in_order, task_slots
 from swtlab_cli.main import main
 from virtual_testbed.flow_render import FlowScene, render_flow, write_flow_render
 
@@ -37,12 +39,15 @@ def _limits(_) -> dict:
             "blas": {i["filepath"]: i["num_threads"] for i in threadpool_info()}}
 
 
-def test_each_task_runs_on_its_share_of_its_hosts_cores(client):
+@pytest.mark.parametrize("limit", [limit_threads, softflow_limit], ids=["runs", "frame_pairs"])
+def test_each_task_runs_on_its_share_of_its_hosts_cores(client, limit):
     """2 one-thread workers on this host: each task gets cores // 2 threads (1 on 2 cores),
-    not the thread per core each library starts with."""
+    not the thread per core each library starts with; with the runs' limit (``swtlab
+    process``) and the frame pairs' (``swtlab flow``)."""
+    client.restart()  # fresh workers: each library at its own thread count, as started
     share = max(1, len(os.sched_getaffinity(0)) // 2)
     assert task_slots(client) == {"127.0.0.1": 2}
-    seen = list(map_in_order(client, _limits, range(4)))
+    seen = list(map_in_order(client, _limits, range(4), limit=limit))
     assert len(seen) == 4
     for limits in seen:
         assert limits["numba"] == share and limits["opencv"] == share
@@ -56,10 +61,10 @@ def _fails(x):
 
 
 def test_results_come_back_in_input_order_and_errors_are_raised(client):
-    assert list(map_in_order(client, _fails, [1, 0, 3])) == [1, 0, 3]
+    assert list(map_in_order(client, _fails, [1, 0, 3], limit=limit_threads)) == [1, 0, 3]
     with pytest.raises(ValueError, match="task 2 failed"):
-        list(map_in_order(client, _fails, [1, 2]))
-    assert list(map_in_order(client, _fails, [])) == []
+        list(map_in_order(client, _fails, [1, 2], limit=limit_threads))
+    assert list(map_in_order(client, _fails, [], limit=limit_threads)) == []
 
 
 @pytest.fixture(scope="module")
@@ -87,7 +92,7 @@ def test_frame_pairs_on_the_cluster_give_the_local_flow(client, render, tmp_path
 
 def test_flow_with_an_unreachable_scheduler_is_one_line_and_exit_3(render, tmp_path, capsys,
                                                                     monkeypatch):
-    from swtlab import cluster
+    from swtlab_base import cluster
 
     monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 1)
     assert main(["flow", str(tmp_path), "--dask", "tcp://127.0.0.1:9"]) == 3

@@ -1,4 +1,4 @@
-"""swtlab.domain: one definition of each domain thing, validated on construction."""
+"""swtlab_base.domain: one definition of each domain thing, validated on construction."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 import ingest
 import terramechanics as tm
 import virtual_testbed as vt
-from swtlab.domain import (COLUMNS, G0_MPS2, MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2, Soil,
+from swtlab_base.domain import (COLUMNS, G0_MPS2, MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2, Soil,
                            TestCondition, Wheel, check_results, wheel_columns, wheels_of)
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"

@@ -19,7 +19,7 @@ import swtlab
 from campaign_report.data import from_results
 from campaign_report.sections import not_measured_note
 from run_results import results_table
-from swtlab.domain.replicates import SINGLE_RUN
+from swtlab_base.domain.replicates import SINGLE_RUN
 from swtlab_cli.main import main
 from validation.second_rig import Rig, RunCondition, Timeline, write_campaign
 

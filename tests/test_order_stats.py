@@ -1,11 +1,11 @@
-"""swtlab.order_stats.median against np.median (the number it replaces)."""
+"""swtlab_base.order_stats.median against np.median (the number it replaces)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from swtlab.order_stats import median
+from swtlab_base.order_stats import median
 
 
 @pytest.mark.parametrize("size", [1, 2, 3, 4, 7, 10, 1001, 60_000])

@@ -16,7 +16,7 @@ import pytest
 import swtlab
 import terramechanics as tm
 from sim_gap.wheel_check import WheelMismatchError
-from swtlab.domain import COLUMNS, Wheel
+from swtlab_base.domain import COLUMNS, Wheel
 
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data"
 LOADS = (70, 180, 300)

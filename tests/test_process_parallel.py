@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 import swtlab
-from swtlab.cores import threads_per_worker
+from swtlab_base.cores import threads_per_worker
 from swtlab.pipeline.process import ProcessSettings, process_file, worker_pool
 from swtlab_cli.main import COMMANDS, command_module, main
 
@@ -144,7 +144,7 @@ def test_a_dask_cluster_of_two_workers_gives_the_serial_results(campaign, serial
 def test_an_unreachable_scheduler_is_one_line_and_exit_3(campaign, tmp_path, capsys,
                                                          monkeypatch):
     pytest.importorskip("distributed")
-    from swtlab import cluster
+    from swtlab_base import cluster
 
     monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 1)
     code = _process(campaign, tmp_path / "db.sqlite", "--dask", "tcp://127.0.0.1:9")

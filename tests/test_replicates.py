@@ -1,4 +1,4 @@
-"""Replicate runs (swtlab.domain.replicates): recognised by their test condition, their
+"""Replicate runs (swtlab_base.domain.replicates): recognised by their test condition, their
 spread set beside the within-run uncertainty, the larger used by the fits."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import pytest
 
 import swtlab
 from fitting import from_run_results
-from swtlab.domain.replicates import NO_REPLICATES, fit_sigma, replicate_spread
+from swtlab_base.domain.replicates import NO_REPLICATES, fit_sigma, replicate_spread
 from swtlab_cli.main import main as swtlab_main
 from virtual_testbed import RunCondition, generate_campaign
 from virtual_testbed.sample_campaign import SAMPLE_RATES

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from swtlab.rounding import decimals, value_and_u
+from swtlab_base.rounding import decimals, value_and_u
 
 
 @pytest.mark.parametrize("value, u, shown", [

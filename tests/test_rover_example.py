@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from fitting import fit_results
-from swtlab.domain import Wheel
+from swtlab_base.domain import Wheel
 from wpm_export import inputs_sha256, write_wpm_csv
 from wpm_export.fmu import build_fmu
 from test_fitting_synthetic import model_results_table

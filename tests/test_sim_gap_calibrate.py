@@ -14,7 +14,7 @@ from sim_gap.calibrate import calibrate_soil, predict_with_se
 from validation.holdout import holdout_dp, holdout_summary
 from sim_gap.measured import from_cmu_smooth_runs
 from sim_gap.priors import published_soils, soil_prior
-from swtlab.domain import G0_MPS2
+from swtlab_base.domain import G0_MPS2
 
 CMU_RUNS = Path(__file__).resolve().parents[2] / "shared/data/cmu-3d-terramechanics/smooth_runs.csv"
 START = Path(__file__).parents[1] / "sim_gap" / "models" / "cmu_smooth_start.toml"

@@ -19,7 +19,7 @@ from sim_gap.hypotheses import (OUTSIDE, P_EFFECT, admissible, hypothesis_priors
                                 outside_prior, set_prior)
 from sim_gap.siblings import contrasts
 from sim_gap.simulated import Simulated
-from swtlab.domain import Wheel
+from swtlab_base.domain import Wheel
 
 BASE = tm.shipped_model("bb2_sand").with_effects(**{n: False for n in tm.EFFECTS})
 FAST = Settings(max_nfev=25, n_boot=20)

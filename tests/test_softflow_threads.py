@@ -10,7 +10,7 @@ from scipy import ndimage
 
 from softflow.flow_engine import pair_displacement_px
 from softflow.threads import capped
-from swtlab.cores import available_cores
+from swtlab_base.cores import available_cores
 
 pytestmark = pytest.mark.skipif(
     not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2

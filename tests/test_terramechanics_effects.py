@@ -19,7 +19,7 @@ import pytest
 from terramechanics import EARTH_GRAVITY_MPS2, EFFECTS, LETE_SAND, Wheel, WheelModel, load_model
 from terramechanics.effects import BulldozingBekker1969, GrousersBekker1956, make_effect
 from terramechanics.model_file import SHIPPED_MODELS
-from swtlab.domain import MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2
+from swtlab_base.domain import MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2
 
 BB2_FILE = SHIPPED_MODELS / "bb2_sand.toml"
 SLIPS = np.linspace(0.0, 0.9, 19)

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from fitting import LoadExtrapolationWarning, LoadRangeError, fit_results
-from swtlab.domain import Wheel
+from swtlab_base.domain import Wheel
 from wpm_export import (WheelPerformanceModule, WpmFormatError, WpmSelectionError,
                         inputs_sha256, read_wpm_csv, write_wpm_csv)
 from wpm_export.clib import CWheelPerformanceModule

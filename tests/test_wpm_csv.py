@@ -210,7 +210,7 @@ GEOMETRY = ('# wheel_geometry: {"bb2": {"radius_m": 0.125, "width_m": 0.112, "gr
 
 
 def test_wheel_geometry_round_trips_and_old_files_still_read(tmp_path, table, fits):
-    from swtlab.domain import Wheel
+    from swtlab_base.domain import Wheel
     from wpm_export import WheelPerformanceModule
 
     wheel = Wheel(0.125, 0.112, 12, 0.0092, stiffness_n_per_mm=30.0, name=fits[0].wheel)

@@ -6,8 +6,8 @@ import pandas as pd
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from swtlab.domain.replicates import with_repeatability
-from swtlab.domain.results import (COLUMNS, budget_columns, check_results, not_measured_text,
+from swtlab_base.domain.replicates import with_repeatability
+from swtlab_base.domain.results import (COLUMNS, budget_columns, check_results, not_measured_text,
                                    wheel_columns)
 
 from traceability.models import (Campaign, RawFile, Run, RunQuantity, RunResult,

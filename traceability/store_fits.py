@@ -11,7 +11,7 @@ import pandas as pd
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from plain_json import jsonable
+from swtlab_base.plain_json import jsonable
 from traceability.models import CurveFit, RunResult, WpmExport
 from traceability.provenance import swtlab_version
 from traceability.store import new_processing_record

@@ -10,7 +10,7 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from plain_json import jsonable
+from swtlab_base.plain_json import jsonable
 from traceability.models import RawFile, SoilFlow, SoilFlowFailure, SoilFlowFit, StableWindow
 from traceability.store import new_processing_record
 from traceability.store_results import params_sha256

@@ -10,8 +10,8 @@ from typing import Any
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from plain_json import jsonable
-from swtlab.domain.results import UNCERTAINTY_TERMS
+from swtlab_base.plain_json import jsonable
+from swtlab_base.domain.results import UNCERTAINTY_TERMS
 from traceability.provenance import swtlab_version
 from traceability.models import RawFile, Run, RunQuantity, RunResult, RunUncertainty, StableWindow
 from traceability.store import new_processing_record

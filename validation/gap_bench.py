@@ -46,8 +46,8 @@ import numpy as np
 
 import terramechanics as tm
 from sim_gap.vocabulary import EFFECT_NAMES
-from swtlab.atomic import write_atomically
-from swtlab.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
+from swtlab_base.atomic import write_atomically
+from swtlab_base.domain.gravity import G0_MPS2, MARS_GRAVITY_MPS2
 
 TRUTH_LAWS = ("in-family", "held-out")
 SIGNAL_MODELS = ("testbed", "second")
@@ -228,9 +228,10 @@ def make_campaigns(n: int, seed: int, workdir: Path, design: Design = Design(),
     jobs = [(workdir, f"c{i:03d}", truth, seed * 1000 + i, design, signal_model)
             for i, (truth, _) in enumerate(truths)]
     if client is not None:
-        from swtlab.cluster import map_in_order
+        from swtlab.pipeline.process import limit_threads
+        from swtlab_base.cluster import map_in_order
 
-        list(map_in_order(client, _generate, jobs))
+        list(map_in_order(client, _generate, jobs, limit=limit_threads))
     else:
         with ProcessPoolExecutor(workers) as pool:
             list(pool.map(_generate, jobs))
@@ -416,11 +417,13 @@ def _diagnose_and_score(labels: Path, workdir: Path, n: int, jobs: int, boot: in
     t1 = time.perf_counter()
     names = [f"c{i:03d}" for i in range(n)]
     if client is not None:  # one task, one core per campaign: its runs in one process
-        from swtlab.cluster import map_in_order, task_slots
+        from swtlab.pipeline.process import limit_threads
+        from swtlab_base.cluster import map_in_order, task_slots
 
         jobs = sum(task_slots(client).values())
         seconds = list(map_in_order(client, diagnose_campaign, [workdir] * n, names,
-                                    [boot] * n, [process] * n, [1] * n, [truth_laws] * n))
+                                    [boot] * n, [process] * n, [1] * n, [truth_laws] * n,
+                                    limit=limit_threads))
     else:
         with ThreadPoolExecutor(jobs) as pool:
             seconds = list(pool.map(lambda name: diagnose_campaign(

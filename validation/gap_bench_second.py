@@ -20,7 +20,7 @@ from validation.second_rig import Rig, RunCondition, Timeline, WheelGeometry, wr
 
 def rig_conditions(conds, campaign: str, w) -> list[RunCondition]:
     """Speed-control conditions of the virtual testbed (gap_bench's ``conditions``) as
-    second-rig conditions, on the virtual testbed's wheel ``w`` (a ``swtlab.domain.Wheel``
+    second-rig conditions, on the virtual testbed's wheel ``w`` (a ``swtlab_base.domain.Wheel``
     with its stiffness)."""
     wheel = WheelGeometry(name=w.name, radius_m=w.radius_m, width_m=w.width_m,
                           grouser_count=w.grouser_count, grouser_height_m=w.grouser_height_m,

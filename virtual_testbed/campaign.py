@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 from virtual_testbed.conditions import RunCondition
 from virtual_testbed.lateral import LateralLaw
 from virtual_testbed.law import PerformanceLaw, bb2_sand_law

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from swtlab.domain import G0_MPS2, MODES
+from swtlab_base.domain import G0_MPS2, MODES
 #: modes whose slip the testbed imposes through the wheel and sled speeds
 SLIP_IMPOSED = ("speed_control", "steered")
 #: 40 m/h, the travel velocity of the ESA/ExoMars SWT campaigns.

@@ -46,7 +46,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from swtlab.atomic import atomic_file, write_atomically
+from swtlab_base.atomic import atomic_file, write_atomically
 
 TRUTH_SCHEMA = "swtlab.virtual_testbed.flow_render/1"
 GROUSER_MODELS = ("piecewise", "cosine", "cosine_series", "gear")

@@ -16,7 +16,7 @@ from typing import Protocol
 import numpy as np
 from scipy.optimize import brentq
 
-from swtlab.domain.gravity import G0_MPS2
+from swtlab_base.domain.gravity import G0_MPS2
 from terramechanics import ModelLaw, shipped_model
 
 

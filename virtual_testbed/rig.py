@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from swtlab.domain import Wheel
+from swtlab_base.domain import Wheel
 
 __all__ = ["BB2_WHEEL", "Suspension", "Timeline", "Wheel"]
 

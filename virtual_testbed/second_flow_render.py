@@ -43,7 +43,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 
 BACKGROUNDS = ("sky", "wall", "frame")
 

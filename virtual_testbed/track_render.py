@@ -21,7 +21,7 @@ import cv2
 import numpy as np
 from scipy.ndimage import gaussian_filter1d, maximum_filter1d, uniform_filter1d
 
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 from virtual_testbed.rig import BB2_WHEEL
 
 TRUTH_SCHEMA = "swtlab.virtual_testbed.track_render/1"

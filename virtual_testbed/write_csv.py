@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from swtlab.atomic import atomic_file, write_atomically
+from swtlab_base.atomic import atomic_file, write_atomically
 from virtual_testbed.measure import RawRun
 from virtual_testbed.topics import TOPIC_FIELDS, csv_name
 

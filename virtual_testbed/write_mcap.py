@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
-from swtlab.atomic import atomic_file
+from swtlab_base.atomic import atomic_file
 from virtual_testbed.measure import RawRun
 from virtual_testbed.topics import TOPIC_FIELDS
 

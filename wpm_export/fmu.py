@@ -14,7 +14,7 @@ import zipfile
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-from swtlab.atomic import write_atomically
+from swtlab_base.atomic import write_atomically
 from wpm_export.clib import CWheelPerformanceModule, library_path
 
 MODEL_IDENTIFIER = "swtwpm_wheel"

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from fitting.curve import DEGREES, PowerCurve
-from swtlab.domain import Wheel
+from swtlab_base.domain import Wheel
 from wpm_export.schema import (BRANCH_COLUMNS, COEFFICIENT_COLUMNS, COLUMNS, FORMAT,
                                UNCERTAINTY_COLUMNS, UNITS, WHEEL_GEOMETRY_KEY, WHEEL_KEYS,
                                WpmFormatError)
@@ -127,7 +127,7 @@ def _uncertainty(row: dict[str, str], degree: int, problem) -> dict:
 
 
 def wheel_geometry(header: dict[str, str], path="<text>", line: int = 0) -> dict[str, Wheel]:
-    """Wheel name -> :class:`swtlab.domain.Wheel` from the header key ``wheel_geometry``
+    """Wheel name -> :class:`swtlab_base.domain.Wheel` from the header key ``wheel_geometry``
     (empty for a file without it: older files and other tools' may lack it)."""
     text = header.get(WHEEL_GEOMETRY_KEY)
     if text is None:

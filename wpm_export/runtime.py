@@ -21,7 +21,7 @@ import numpy as np
 
 from fitting.errors import LoadExtrapolationWarning, LoadRangeError, OutsideSlipRangeWarning
 from fitting.load_interp import InterpolatedCurve, LoadPolynomial, interpolate_loads
-from swtlab.domain import Wheel
+from swtlab_base.domain import Wheel
 from wpm_export.inverse import SlipSolution
 from wpm_export.reader import WpmCurve, read_wpm_csv, wheel_geometry
 from wpm_export.schema import UNITS, WpmSelectionError

@@ -14,8 +14,8 @@ import pandas as pd
 from fitting.curve import CurveFit
 from fitting.table import KEY_COLUMNS, MEASURED
 from wpm_export.reader import parse_wpm_csv
-from swtlab.atomic import write_atomically
-from swtlab.domain import Wheel
+from swtlab_base.atomic import write_atomically
+from swtlab_base.domain import Wheel
 from wpm_export.schema import (BRANCH_COLUMNS, COLUMNS, FORMAT, MAX_DEGREE,
                                UNCERTAINTY_COLUMNS, UNITS, WHEEL_GEOMETRY_KEY, WHEEL_KEYS)
 
@@ -106,7 +106,7 @@ def wpm_csv_text(fits: Iterable[CurveFit], inputs_sha256: str, swtlab_version: s
 def write_wpm_csv(fits: Iterable[CurveFit], path, inputs_sha256: str, swtlab_version: str,
                   created: str | None = None, wheels: dict[str, Wheel] | None = None) -> str:
     """Write the WPM CSV to ``path`` (UTF-8, ``\\n`` line ends) atomically
-    (``swtlab.atomic``); return the file's sha256."""
+    (``swtlab_base.atomic``); return the file's sha256."""
     data = wpm_csv_text(fits, inputs_sha256, swtlab_version, created, wheels).encode("utf-8")
     write_atomically(path, data)
     return hashlib.sha256(data).hexdigest()

@@ -8,7 +8,7 @@ from typing import Any
 
 import pandas as pd
 
-from swtlab.domain import Wheel, check_results, wheels_of
+from swtlab_base.domain import Wheel, check_results, wheels_of
 
 
 @dataclass(frozen=True)
@@ -69,7 +69,7 @@ class ProcessedRun:
 @dataclass
 class Campaign:
     """A processed campaign: ``runs`` (:class:`ProcessedRun`), ``results`` (one row per run in
-    the schema of :mod:`swtlab.domain.results`, docs/results.md), ``failures`` (every run or
+    the schema of :mod:`swtlab_base.domain.results`, docs/results.md), ``failures`` (every run or
     part of one that failed, with file, stage and reason), the processing ``parameters`` and
     the ``source`` database URL of a campaign loaded from one."""
 
@@ -90,15 +90,15 @@ class Campaign:
     @property
     def replicates(self) -> pd.DataFrame:
         """Spread of the replicate runs beside their within-run uncertainty, per condition and
-        quantity (``swtlab.domain.replicates.replicate_spread``); empty without replicates."""
-        from swtlab.domain.replicates import replicate_spread
+        quantity (``swtlab_base.domain.replicates.replicate_spread``); empty without replicates."""
+        from swtlab_base.domain.replicates import replicate_spread
 
         return replicate_spread(self.results)
 
     @property
     def repeatability(self) -> str:
         """One line: how many conditions have replicates, or that the campaign has none."""
-        from swtlab.domain.replicates import NO_REPLICATES, REPLICATE_KEY
+        from swtlab_base.domain.replicates import NO_REPLICATES, REPLICATE_KEY
 
         spread = self.replicates
         if spread.empty:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from swtlab.domain import Wheel, check_results, wheels_of
+from swtlab_base.domain import Wheel, check_results, wheels_of
 from swtlab.pipeline.campaign import Campaign
 
 

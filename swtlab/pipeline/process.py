@@ -147,11 +147,11 @@ def process_file(path: Path, settings: ProcessSettings,
 @contextmanager
 def worker_pool(workers: int) -> Iterator[ProcessPoolExecutor]:
     """``workers`` processes, each limited to its share of this process's cores
-    (``swtlab.cores.threads_per_worker``). OpenCV's share is set here too while the pool
+    (``swtlab_base.cores.threads_per_worker``). OpenCV's share is set here too while the pool
     runs, for the workers forked from this process to inherit (see
     ``softflow.threads.opencv_threads``)."""
     from softflow.threads import opencv_threads
-    from swtlab.cores import threads_per_worker
+    from swtlab_base.cores import threads_per_worker
 
     threads = threads_per_worker(workers)
     with opencv_threads(threads), ProcessPoolExecutor(
@@ -159,14 +159,25 @@ def worker_pool(workers: int) -> Iterator[ProcessPoolExecutor]:
         yield pool
 
 
+def limit_threads(threads: int) -> None:
+    """Run this process's numba, OpenCV and BLAS/OpenMP on at most ``threads`` threads (each
+    :func:`worker_pool` worker's initializer, and each dask task's,
+    ``swtlab_base.cluster.map_in_order``: N workers each with every core's threads
+    oversubscribe the machine; numba's count is the calling thread's). The libraries a run
+    loads are imported first: threadpoolctl limits only those loaded."""
+    import ingest  # noqa: F401 - loaded before the limits, see above
+    import run_results.process  # noqa: F401
+    from softflow.threads import limit
+
+    limit(threads)
+
+
 def _start_worker(threads: int, parent_pid: int) -> None:
-    """A worker's start: its share of the threads (``swtlab.cores.limit_threads``), and its
+    """A worker's start: its share of the threads (:func:`limit_threads`), and its
     end with the batch's process. A batch killed by SIGKILL runs no clean-up, and its forked
     workers, holding both ends of their task queue's pipe, would wait on it for ever; on
     Linux the kernel sends them SIGTERM when their parent dies (``prctl(PR_SET_PDEATHSIG)``,
     prctl(2)), and a worker whose parent died before the request ends at once."""
-    from swtlab.cores import limit_threads
-
     limit_threads(threads)
     if sys.platform != "linux":
         return
@@ -192,7 +203,7 @@ def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *
     """:func:`process_file` of each of ``paths``, yielded in their order as they are done:
     in this process (``jobs`` 1), on ``jobs`` worker processes (:func:`worker_pool`: each
     on its share of the cores), or on the workers of the ``dask.distributed`` ``client``
-    (``swtlab.cluster.map_in_order``: each on its share of its host's cores).
+    (``swtlab_base.cluster.map_in_order``: each on its share of its host's cores).
     ``contents``: each file's (sha256, size) or None; ``keep_samples=False`` drops each
     run's sample tables (``streams``, ``channels``, ``frames``) before it comes back from a
     worker (results, metadata and problems stay)."""
@@ -201,9 +212,9 @@ def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *
     work = list(zip(paths, [settings] * len(paths), contents or [None] * len(paths),
                     [keep_samples] * len(paths)))
     if client is not None:
-        from swtlab.cluster import map_in_order
+        from swtlab_base.cluster import map_in_order
 
-        yield from map_in_order(client, _process, *zip(*work))
+        yield from map_in_order(client, _process, *zip(*work), limit=limit_threads)
     elif jobs > 1 and len(work) > 1:
         with worker_pool(min(jobs, len(work))) as pool:
             yield from pool.map(_process, *zip(*work))

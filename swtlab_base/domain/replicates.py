@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from swtlab.domain.results import not_measured_text
+from swtlab_base.domain.results import not_measured_text
 
 #: the columns that make two runs replicates of one condition
 REPLICATE_KEY = ("wheel", "soil", "mode", "multipass", "load_set_n", "slip_setpoint",

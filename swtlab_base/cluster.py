@@ -5,13 +5,15 @@ the order of the inputs. ``swtlab process`` (runs), ``swtlab flow`` (frame pairs
 
 Each task runs numba, OpenCV and BLAS/OpenMP on its share of its host's cores: the cores
 the worker may run on split evenly over the task threads (``nthreads``) of all workers on
-that host, at least one (:func:`worker_threads`); left alone, every worker would start a
-thread per core.
+that host, at least one (:func:`worker_threads`), applied by the ``limit`` the caller
+passes (it knows which libraries its tasks load: ``swtlab.pipeline.process.limit_threads``
+for runs, ``softflow.threads.limit`` for frame pairs); left alone, every worker would start
+a thread per core.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 #: how long :func:`connect` waits for its scheduler
 CONNECT_TIMEOUT_S = 20
@@ -45,30 +47,29 @@ def worker_threads(slots: dict[str, int]) -> int:
     since: its own), at least one."""
     from distributed import get_worker
 
-    from swtlab.cores import available_cores
+    from swtlab_base.cores import available_cores
 
     worker = get_worker()
     return max(1, available_cores() // max(1, slots.get(worker.ip, worker.state.nthreads)))
 
 
-def _capped(fn, slots: dict[str, int], *args):
-    from swtlab.cores import limit_threads
-
-    limit_threads(worker_threads(slots))
+def _capped(fn, limit: Callable[[int], None], slots: dict[str, int], *args):
+    limit(worker_threads(slots))
     return fn(*args)
 
 
-def map_in_order(client, fn, *iterables) -> Iterator:
+def map_in_order(client, fn, *iterables, limit: Callable[[int], None]) -> Iterator:
     """``fn(*args)`` for each ``args`` of ``zip(*iterables)``, on the workers of ``client``
-    (each task on its share of its host's cores), yielded in input order as they are done;
-    an error raised by ``fn`` is raised here. Arguments may be the client's futures
-    (``client.scatter``: data sent once, used by several tasks)."""
+    (each task first calls ``limit(threads)`` with its share of its host's cores), yielded
+    in input order as they are done; an error raised by ``fn`` is raised here. Arguments
+    may be the client's futures (``client.scatter``: data sent once, used by several
+    tasks)."""
     work = list(zip(*iterables))
     if not work:
         return
     slots = task_slots(client)
-    futures = client.map(_capped, [fn] * len(work), [slots] * len(work), *zip(*work),
-                         pure=False)
+    n = len(work)
+    futures = client.map(_capped, [fn] * n, [limit] * n, [slots] * n, *zip(*work), pure=False)
     for future in futures:
         yield future.result()
         future.release()

@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from swtlab.domain.condition import MODES
-from swtlab.domain.wheel import Wheel
+from swtlab_base.domain.condition import MODES
+from swtlab_base.domain.wheel import Wheel
 
 STATS = ("mean", "std", "se")
 STATUSES = ("ok", "flagged", "no_stable_phase")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from swtlab.domain.gravity import G0_MPS2
+from swtlab_base.domain.gravity import G0_MPS2
 
 MODES = ("speed_control", "free_sled", "towed", "steered")
 
