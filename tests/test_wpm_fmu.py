@@ -42,6 +42,53 @@ def test_fmpy_validation_finds_no_problem(made):
     assert validate_fmu(str(made[1])) == []
 
 
+def _write_csv(path, columns: dict) -> None:
+    """A CSV of the FMI cross-check rules: a header of the names, time first."""
+    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",",
+               header=",".join(columns), comments="", fmt="%.17g")
+
+
+@pytest.mark.filterwarnings("ignore:Please import:DeprecationWarning")  # FMPy's scipy import
+def test_the_fmi_cross_check_rules_find_no_problem(made, tmp_path):
+    """The checks the FMI cross-check repository runs on a vendor's test FMUs and results, as
+    FMPy implements them (``fmpy.cross_check.validate_vendor_repo``: the model description
+    against the FMI schema, FMI version and kind, the input, reference and options files,
+    and the importing tool's result within the rules' band about the reference): the FMU
+    laid out as swtlab's test FMU, its reference the Python runtime's answers, FMPy the
+    importing tool. A result 20 % off is caught (the check is live)."""
+    from fmpy.cross_check.validate_vendor_repo import validate_repo
+    from importlib.metadata import version
+
+    csv, fmu = made
+    model = "swtwpm_wheel"  # the cross-check rules: <model>/<model>.fmu
+    repo = tmp_path / "swtlab-fmi-cross-check"
+    exported = repo / "fmus" / "2.0" / "cs" / "linux64" / "swtlab" / version("swtlab") / model
+    exported.mkdir(parents=True)
+    (exported / f"{model}.fmu").write_bytes(fmu.read_bytes())
+    t = np.linspace(0.0, 2.0, 201)
+    load_n, slip = 75.0 + 110.0 * (1 + np.sin(3 * t)), 0.05 + 0.25 * (1 + np.sin(2 * t))
+    names = ["dp_n", "torque_nm", "sinkage_m", "resistance_n"]
+    expected = WheelPerformanceModule.load(csv).at_slip(slip, load_n, multipass=1)
+    _write_csv(exported / f"{model}_in.csv", {"time": t, "load_n": load_n, "slip": slip})
+    _write_csv(exported / f"{model}_ref.csv", {"time": t, **{q: expected[q] for q in names}})
+    (exported / f"{model}_ref.opt").write_text(
+        "StartTime,0.0\nStopTime,2.0\nStepSize,0.01\nRelTol,1e-06\n")
+    # the importing tool, as the rules run it: the input file, the options' step and stop
+    inputs = np.genfromtxt(exported / f"{model}_in.csv", delimiter=",", names=True)
+    result = fmpy.simulate_fmu(str(exported / f"{model}.fmu"), input=inputs, step_size=0.01,
+                               stop_time=2.0, output=names)
+    imported = (repo / "results" / "2.0" / "cs" / "linux64" / "FMPy" / fmpy.__version__
+                / "swtlab" / version("swtlab") / model)
+    imported.mkdir(parents=True)
+    out = {"time": result["time"], **{q: result[q] for q in names}}
+    _write_csv(imported / f"{model}_out.csv", out)
+    (imported / "passed").touch()
+    assert validate_repo(str(repo)) == (1, 1, [])
+    _write_csv(imported / f"{model}_out.csv", {**out, "dp_n": 1.2 * result["dp_n"]})
+    _, _, problems = validate_repo(str(repo))
+    assert len(problems) == 1 and 'outside epsilon band for variable "dp_n"' in problems[0]
+
+
 def test_a_time_varying_load_and_slip_give_the_runtimes_outputs(made):
     csv, fmu = made
     t = np.linspace(0.0, 2.0, 9)
