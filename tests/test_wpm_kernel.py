@@ -274,6 +274,10 @@ def test_the_0_14_names_are_the_same_calls():
     (lambda w: w.curve("dp_n", 20.0, multipass=0), r"^load_n=20 N is outside the tested"),
     (lambda w: w.slip_for("dp_n", "25", 120.0, multipass=0),
      r"^target='25', load_n=120.0: numbers expected$"),
+    (lambda w: w.slip_for("dp_n", np.float64("nan"), 120.0, multipass=0),  # NumPy's number
+     r"^target=nan: dp_n queries need a finite number$"),
+    (lambda w: w.band("dp_n", 0.1, np.int64(0), multipass=0),  # printed as the C library does
+     r"^load_n=0.0: the wheel load must be a finite number > 0 N$"),
     (lambda w: w.band("dp_n", [0.1, 0.2], ["120", "130"], multipass=0),
      r"^slip=<list of float64>, load_n=<list of <U3>: numbers expected$"),
     (lambda w: w.slip_for("dp_n", 1.0, 120.0, wheel="mars_wheel"),

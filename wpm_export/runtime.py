@@ -148,9 +148,12 @@ class WheelPerformanceModule:
         """Raise for an error code of the kernel (the message names the keyword argument),
         else warn that ``count`` loads were extrapolated."""
         k, tested = self._kernel, self._tested(table)
+        if isinstance(load_n, NUMBER):  # NumPy's numbers, ints: as the C library prints them
+            load_n = float(load_n)
+        value = _shown(value)
         span = f"{tested[0]:g}-{tested[-1]:g} N" if tested.size > 1 else f"{tested[0]:g} N"
         if code == k.BAD_TARGET or code == k.BAD_SLIP:
-            raise ValueError(f"{name}={value!r}: {quantity} queries need a finite number")
+            raise ValueError(f"{name}={value}: {quantity} queries need a finite number")
         if code == k.BAD_LOAD:
             raise LoadRangeError(f"load_n={load_n!r}: the wheel load must be a finite number "
                                  "> 0 N")
@@ -241,7 +244,8 @@ class WheelPerformanceModule:
                 value, conf, pred, code = self._kernel.value_number(table, slip, load_n,
                                                                     allow_extrapolation)
             except (TypeError, OverflowError):  # e.g. an int beyond the doubles
-                raise TypeError(f"slip={slip!r}, load_n={load_n!r}: numbers expected") from None
+                raise TypeError(f"slip={_shown(slip)}, load_n={_shown(load_n)}: numbers "
+                                "expected") from None
             if code:
                 self._outcome(code, quantity, table, load_n, slip, "slip")
             return value, conf, pred
@@ -269,7 +273,7 @@ class WheelPerformanceModule:
                 slip, value, code = self._kernel.solve_number(table, target, load_n,
                                                               allow_extrapolation)
             except (TypeError, OverflowError):  # e.g. an int beyond the doubles
-                raise TypeError(f"target={target!r}, load_n={load_n!r}: numbers "
+                raise TypeError(f"target={_shown(target)}, load_n={_shown(load_n)}: numbers "
                                 "expected") from None
             if code < 0 or code >= 4:
                 self._outcome(code, quantity, table, load_n, target)
@@ -312,6 +316,20 @@ def _numbers(x, load_n, name: str) -> tuple[np.ndarray, np.ndarray]:
             raise TypeError
         return tuple(a.astype(float, copy=False) for a in given)
     except (TypeError, ValueError):
-        shown = [repr(a) if np.ndim(a) == 0 else f"<{type(a).__name__} of "
-                 f"{np.asarray(a).dtype}>" for a in (x, load_n)]
-        raise TypeError(f"{name}={shown[0]}, load_n={shown[1]}: numbers expected") from None
+        raise TypeError(f"{name}={_shown(x)}, load_n={_shown(load_n)}: numbers "
+                        "expected") from None
+
+
+def _shown(given) -> str:
+    """A query's argument in a message: a number as a float, other scalars as typed, arrays
+    by type and dtype."""
+    try:
+        array = np.asarray(given)
+    except ValueError:  # ragged nesting
+        return f"<{type(given).__name__}>"
+    if array.ndim:
+        return f"<{type(given).__name__} of {array.dtype}>"
+    try:
+        return repr(float(given)) if isinstance(given, NUMBER) else repr(given)
+    except OverflowError:  # an int beyond the doubles
+        return repr(given)
