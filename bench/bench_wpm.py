@@ -13,11 +13,13 @@ bounds the cost of the documented method in NumPy; it is not an alternative.
 Cases (goals: scalar >= 200,000/s and >= 5x the baseline's scalar query; arrays >= 2 M/s;
 ratios of CPU seconds of the process, wall-clock ratios printed beside them):
 
-- scalar inverse: ``slip_for_one("dp_n", dp, load)`` (the simulator's call) and
-  ``slip_for`` (arrays API, 0-d answers), vs the baseline's inverse;
-- scalar forward with bands: ``band_one("dp_n", slip, load)`` (value, 95 % confidence and
-  prediction half-widths) vs the baseline's three interpolations;
-- scalar inverse with the slip's bands: ``slip_for_one`` then ``slip_band`` at the slip found
+- scalar inverse: ``slip_for("dp_n", dp, load, multipass=0)`` with two floats (the
+  simulator's call; ``slip_for_one``, its 0.14.0 name, is the same call) vs the baseline's
+  inverse;
+- scalar forward with bands: ``band("dp_n", slip, load, multipass=0)`` with two floats
+  (value, 95 % confidence and prediction half-widths; ``band_one`` the same call) vs the
+  baseline's three interpolations;
+- scalar inverse with the slip's bands: ``slip_for`` then ``slip_band`` at the slip found
   vs the baseline's inverse and band;
 - arrays: ``slip_for`` and ``band`` over 1e5 (target or slip, load) pairs at random loads, and
   ``at_slip`` (all five quantities) vs the baseline on chunks of rows.
@@ -149,14 +151,10 @@ def main(quick: bool = False) -> dict:
     targets = rng.uniform(0.0, 20.0, n_vector)  # DP below the smallest maximum (70 N)
     slips = rng.uniform(-0.1, 0.6, n_vector)
     w, t, s = (a[:n_scalar].tolist() for a in (loads, targets, slips))
-    wpm.slip_for_one("dp_n", 10.0, 100.0, multipass=0)  # packs the table, loads the kernels
-    wpm.band_one("dp_n", 0.1, 100.0, multipass=0)
+    wpm.slip_for("dp_n", 10.0, 100.0, multipass=0)  # packs the table, loads the kernels
+    wpm.band("dp_n", 0.1, 100.0, multipass=0)
 
     # each case a plain loop that drops its answers, as a simulator's time steps do
-    def slip_for_one():
-        for target, load in zip(t, w):
-            wpm.slip_for_one("dp_n", target, load, multipass=0)
-
     def slip_for():
         for target, load in zip(t, w):
             wpm.slip_for("dp_n", target, load, multipass=0)
@@ -165,9 +163,9 @@ def main(quick: bool = False) -> dict:
         for target, load in zip(t, w):
             plain.slip_for(target, load)
 
-    def band_one():
+    def band():
         for slip, load in zip(s, w):
-            wpm.band_one("dp_n", slip, load, multipass=0)
+            wpm.band("dp_n", slip, load, multipass=0)
 
     def baseline_band():
         for slip, load in zip(s, w):
@@ -175,7 +173,7 @@ def main(quick: bool = False) -> dict:
 
     def inverse_with_bands():
         for target, load in zip(t, w):
-            slip, _, _ = wpm.slip_for_one("dp_n", target, load, multipass=0)
+            slip, _, _ = wpm.slip_for("dp_n", target, load, multipass=0)
             wpm.slip_band("dp_n", slip, load, multipass=0)
 
     def baseline_slip_and_band():
@@ -183,9 +181,8 @@ def main(quick: bool = False) -> dict:
             plain.slip_and_band(target, load)
 
     scalar = {name: (call, n_scalar) for name, call in (
-        ("slip_for_one", slip_for_one), ("slip_for", slip_for),
-        ("baseline_slip_for", baseline_slip_for), ("band_one", band_one),
-        ("baseline_band", baseline_band), ("slip_for_one_with_slip_band", inverse_with_bands),
+        ("slip_for", slip_for), ("baseline_slip_for", baseline_slip_for), ("band", band),
+        ("baseline_band", baseline_band), ("slip_for_with_slip_band", inverse_with_bands),
         ("baseline_slip_and_band", baseline_slip_and_band))}
     vector = {
         "vector_slip_for": (lambda: wpm.slip_for("dp_n", targets, loads, multipass=0),
@@ -199,9 +196,8 @@ def main(quick: bool = False) -> dict:
     (scalar_wall, scalar_cpu), (vector_wall, vector_cpu) = (_rates(scalar, repeats),
                                                             _rates(vector, repeats))
     rates, cpu = {**scalar_wall, **vector_wall}, {**scalar_cpu, **vector_cpu}
-    pairs = {"slip_for_one": "baseline_slip_for", "slip_for": "baseline_slip_for",
-             "band_one": "baseline_band",
-             "slip_for_one_with_slip_band": "baseline_slip_and_band",
+    pairs = {"slip_for": "baseline_slip_for", "band": "baseline_band",
+             "slip_for_with_slip_band": "baseline_slip_and_band",
              "vector_slip_for": "baseline_vector_slip_for"}
     # ratios of CPU seconds: on a shared machine the wall clock also counts the time the
     # process waited for a core, which falls on one case more than on its neighbour
@@ -231,13 +227,10 @@ def markdown(numbers: dict) -> str:
         return f"{numbers[name + '_per_cpu_second']:,.0f}"
 
     rows = [
-        ("inverse, `slip_for_one` (simulator loop)", "slip_for_one", "baseline_slip_for",
-         "slip_for_one_vs_baseline"),
-        ("inverse, `slip_for` (arrays API, 0-d answers)", "slip_for", "baseline_slip_for",
-         "slip_for_vs_baseline"),
-        ("forward with bands, `band_one`", "band_one", "baseline_band", "band_one_vs_baseline"),
-        ("inverse + slip bands, `slip_for_one` + `slip_band`", "slip_for_one_with_slip_band",
-         "baseline_slip_and_band", "slip_for_one_with_slip_band_vs_baseline"),
+        ("inverse, `slip_for`", "slip_for", "baseline_slip_for", "slip_for_vs_baseline"),
+        ("forward with bands, `band`", "band", "baseline_band", "band_vs_baseline"),
+        ("inverse + slip bands, `slip_for` + `slip_band`", "slip_for_with_slip_band",
+         "baseline_slip_and_band", "slip_for_with_slip_band_vs_baseline"),
     ]
     lines = [
         "# WPM runtime: queries per second at random loads",
@@ -279,9 +272,9 @@ def markdown(numbers: dict) -> str:
         "",
         "Ratios are of CPU seconds of the process (wall seconds on a loaded machine also "
         "count the waits for a core, unevenly between neighbouring cases); both are shown. "
-        "`slip_for` at one scalar returns its answers as 0-d NumPy arrays in a `SlipSolution` "
-        "(its public form): building those costs more than the query, so its ratio stays "
-        "below the goal; `slip_for_one` is the simulator's call.",
+        "The scalar calls are the public ones with two Python floats, as a simulator makes "
+        "them (`slip_for(\"dp_n\", dp, load_n, multipass=0)`; `slip_for_one` and `band_one`, "
+        "their 0.14.0 names, are the same calls); they answer floats and the status text.",
         "",
         "Answers: the runtime's equal today's within 1e-9 relative (tests/test_wpm_kernel.py); "
         "the baseline answers to its grid only (about 1e-3 in slip).",

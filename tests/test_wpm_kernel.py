@@ -70,7 +70,7 @@ def test_values_and_bands_at_random_loads_are_todays_within_1e_9(wpm, quantity):
             mean, conf, pred = band(curve, s)
             scale = np.max(np.abs(curve.evaluate(np.linspace(curve.slip_min, curve.slip_max,
                                                              101))))
-            one = wpm.band_one(quantity, s, w, multipass=0, allow_extrapolation=True)
+            one = wpm.band(quantity, s, w, multipass=0, allow_extrapolation=True)
             assert abs(one[0] - mean) <= RELATIVE * scale, (w, s)
             assert one[1] == pytest.approx(float(conf), rel=RELATIVE)
             assert one[2] == pytest.approx(float(pred), rel=RELATIVE)
@@ -154,7 +154,7 @@ def test_the_inverse_at_random_loads_is_the_smallest_root_within_1e_9(wpm, quant
         vector = wpm.slip_for(quantity, targets, loads, multipass=0, allow_extrapolation=True)
         checked = 0
         for i, ((slip, value, status, margin), scale) in enumerate(expected):
-            one = wpm.slip_for_one(quantity, targets[i], loads[i], multipass=0,
+            one = wpm.slip_for(quantity, targets[i], loads[i], multipass=0,
                                    allow_extrapolation=True)
             assert one == (float(vector.slip[i]), float(vector.value[i]),
                            str(vector.status[i])) or np.isnan(one[0])
@@ -215,49 +215,75 @@ def test_curves_without_uncertainty_give_nan_bands_and_their_values():
                      line=3, step_below_zero=-2.0, slope_below_zero=5.0)
             for k, load in enumerate((100.0, 200.0, 300.0))]
     wpm = WheelPerformanceModule(rows)
-    value, conf, pred = wpm.band_one("dp_n", -0.1, 150.0)
+    value, conf, pred = wpm.band("dp_n", -0.1, 150.0)
     expected = interpolate_loads({c.load_n: c for c in rows}, [150.0]).curve(0)
     assert value == pytest.approx(float(expected.evaluate(-0.1)), rel=RELATIVE)
     assert np.isnan(conf) and np.isnan(pred)
     assert np.isnan(wpm.slip_band("dp_n", 0.2, 150.0)).all()
 
 
-def test_scalar_and_array_inverse_agree_on_repeated_and_fresh_loads(wpm):
+def test_numbers_give_floats_and_arrays_give_arrays_with_the_same_answers(wpm):
+    """A query of numbers (Python's or NumPy's: a simulator's time step) gives floats and the
+    status text, equal to the array call's element (one kernel for both); 0-d arrays give
+    0-d arrays; repeated loads (which reuse the cuts in the array kernel) and fresh ones."""
     rng = np.random.default_rng(9)
-    loads = np.repeat(rng.uniform(80.0, 290.0, 20), 5)  # repeated loads reuse the cuts
+    loads = np.repeat(rng.uniform(80.0, 290.0, 20), 5)
     targets = rng.uniform(-20.0, 60.0, loads.size)
+    slips = rng.uniform(-0.1, 0.6, loads.size)
     found = wpm.slip_for("dp_n", targets, loads, multipass=1)
+    bands = wpm.band("dp_n", slips, loads, multipass=1)
     for i in range(loads.size):
-        one = wpm.slip_for_one("dp_n", targets[i], loads[i], multipass=1)
-        assert one[2] == found.status[i] and one[1] == found.value[i]
-        assert one[0] == found.slip[i] or (np.isnan(one[0]) and np.isnan(found.slip[i]))
-    scalar = wpm.slip_for("dp_n", float(targets[0]), float(loads[0]), multipass=1)
-    assert scalar.slip.shape == () and str(scalar.status) == found.status[0]
+        for target, load in ((float(targets[i]), float(loads[i])), (targets[i], loads[i])):
+            one = wpm.slip_for("dp_n", target, load, multipass=1)
+            assert (type(one.slip), type(one.value), type(one.status)) == (float, float, str)
+            assert one.status == found.status[i] and one.value == found.value[i]
+            assert one.slip == found.slip[i] or (np.isnan(one.slip) and np.isnan(found.slip[i]))
+            assert one.reached == found.reached[i]
+        forward = wpm.band("dp_n", float(slips[i]), float(loads[i]), multipass=1)
+        assert forward == tuple(float(a[i]) for a in bands)
+        assert all(type(v) is float for v in forward)
+    zero_d = wpm.slip_for("dp_n", np.array(targets[0]), loads[0], multipass=1)
+    assert zero_d.slip.shape == () and str(zero_d.status) == found.status[0]
+    assert wpm.slip_for("dp_n", 10, 150, multipass=1) == wpm.slip_for("dp_n", 10.0, 150.0,
+                                                                       multipass=1)
+    slip, value, status = wpm.slip_for("dp_n", 10.0, 150.0, multipass=1)  # unpacks
+    assert value == 10.0 and status == "ok" and 0.0 < slip < 0.6
+
+
+def test_the_0_14_names_are_the_same_calls():
+    assert WheelPerformanceModule.slip_for_one is WheelPerformanceModule.slip_for
+    assert WheelPerformanceModule.band_one is WheelPerformanceModule.band
 
 
 @pytest.mark.parametrize("call, match", [
-    (lambda w: w.slip_for_one("dp_n", float("nan"), 120.0, multipass=0),
+    (lambda w: w.slip_for("dp_n", float("nan"), 120.0, multipass=0),
      r"^target=nan: dp_n queries need a finite number$"),
     (lambda w: w.slip_for("dp_n", [1.0, np.inf], 120.0, multipass=0),
      r"^target=inf: dp_n queries need a finite number$"),
-    (lambda w: w.band_one("torque_nm", float("nan"), 120.0, multipass=0),
+    (lambda w: w.band("torque_nm", float("nan"), 120.0, multipass=0),
      r"^slip=nan: torque_nm queries need a finite number$"),
     (lambda w: w.at_slip([0.1, np.nan], 120.0, multipass=0),
      r"^slip=nan: dp_n queries need a finite number$"),
-    (lambda w: w.slip_for_one("dp_n", 1.0, float("nan"), multipass=0),
+    (lambda w: w.slip_for("dp_n", 1.0, float("nan"), multipass=0),
      r"^load_n=nan: the wheel load must be a finite number > 0 N$"),
     (lambda w: w.band("dp_n", 0.1, [120.0, -5.0], multipass=0),
      r"^load_n=-5.0: the wheel load must be a finite number > 0 N$"),
-    (lambda w: w.slip_for_one("dp_n", 1.0, 500.0, multipass=0),
+    (lambda w: w.slip_for("dp_n", 1.0, 500.0, multipass=0),
      r"^load_n=500 N is outside the tested loads \(\d+-300 N\) of dp_n; pass "
      r"allow_extrapolation=True to extrapolate linearly from the two nearest loads$"),
     (lambda w: w.curve("dp_n", 20.0, multipass=0), r"^load_n=20 N is outside the tested"),
-    (lambda w: w.slip_for_one("dp_n", "25", 120.0, multipass=0),
+    (lambda w: w.slip_for("dp_n", "25", 120.0, multipass=0),
      r"^target='25', load_n=120.0: numbers expected$"),
-    (lambda w: w.slip_for_one("dp_n", 1.0, 120.0, wheel="mars_wheel"),
+    (lambda w: w.slip_for("dp_n", np.float64("nan"), 120.0, multipass=0),  # NumPy's number
+     r"^target=nan: dp_n queries need a finite number$"),
+    (lambda w: w.band("dp_n", 0.1, np.int64(0), multipass=0),  # printed as the C library does
+     r"^load_n=0.0: the wheel load must be a finite number > 0 N$"),
+    (lambda w: w.band("dp_n", [0.1, 0.2], ["120", "130"], multipass=0),
+     r"^slip=<list of float64>, load_n=<list of <U3>: numbers expected$"),
+    (lambda w: w.slip_for("dp_n", 1.0, 120.0, wheel="mars_wheel"),
      r"^no curves for wheel='mars_wheel' in .*wpm.csv; choices: "
      r"soil='bb2_sand', wheel='bb2', multipass=0; soil='bb2_sand', wheel='bb2', multipass=1$"),
-    (lambda w: w.band_one("drawbar", 0.1, 120.0, multipass=0),
+    (lambda w: w.band("drawbar", 0.1, 120.0, multipass=0),
      r"^quantity='drawbar': no such curves for soil='bb2_sand', wheel='bb2', multipass=0 in "
      r".*; it has dp_n, torque_nm, sinkage_m, resistance_n, dp_over_w$"),
 ])
@@ -275,7 +301,7 @@ def test_bad_queries_raise_one_line_naming_the_keyword(wpm, call, match):
 def test_extrapolated_loads_warn_once_per_call_naming_the_load(wpm):
     with pytest.warns(LoadExtrapolationWarning, match=r"^1 load\(s\) outside the tested loads "
                                                       r"\(.*\) of dp_n, e.g. load_n=400 N"):
-        wpm.slip_for_one("dp_n", 10.0, 400.0, multipass=0, allow_extrapolation=True)
+        wpm.slip_for("dp_n", 10.0, 400.0, multipass=0, allow_extrapolation=True)
     with pytest.warns(LoadExtrapolationWarning, match=r"^2 load\(s\) outside"):
         wpm.band("dp_n", 0.2, [400.0, 120.0, 10.0], multipass=0, allow_extrapolation=True)
 

@@ -21,33 +21,26 @@ value the target, status ``at_step`` (counted as reached).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 STATUS_OK, STATUS_ABOVE, STATUS_BELOW, STATUS_STEP = "ok", "above_max", "below_min", "at_step"
 
 
-@dataclass(frozen=True)
-class SlipSolution:
+class SlipSolution(NamedTuple):
     """Per target: ``slip`` (1.0 when above the maximum, NaN below the minimum, 0.0 inside the
     jump at zero slip), ``value`` the curve there (the extreme when unreachable, the target
-    inside the jump), ``status`` ok / above_max / below_min / at_step."""
+    inside the jump), ``status`` ok / above_max / below_min / at_step. Arrays for arrays of
+    targets; floats and the status text for one number (it unpacks as
+    ``slip, value, status``)."""
 
-    slip: np.ndarray
-    value: np.ndarray
-    status: np.ndarray
-
-    @classmethod
-    def of(cls, slip: np.ndarray, value: np.ndarray, status: np.ndarray) -> SlipSolution:
-        """The same as ``SlipSolution(slip=..., value=..., status=...)``, built without the
-        frozen dataclass's checked ``__init__`` (a third of a scalar ``slip_for``)."""
-        out = object.__new__(cls)
-        out.__dict__.update(slip=slip, value=value, status=status)
-        return out
+    slip: np.ndarray | float
+    value: np.ndarray | float
+    status: np.ndarray | str
 
     @property
-    def reached(self) -> np.ndarray:
+    def reached(self) -> np.ndarray | bool:
         return (self.status == STATUS_OK) | (self.status == STATUS_STEP)
 
 

@@ -392,6 +392,19 @@ def value_one(table, slip, load, allow):
     return _value(w, int(table[DEGREE]), slip), conf, pred, code
 
 
+def _machine_code(kernel):
+    """The compiled function of a kernel of one explicit signature, called without the
+    dispatcher (which types every argument to pick the overload: a sixth of a scalar query).
+    Its arguments must be of the signature's types: a packed table, then numbers (unboxed
+    as ``float(x)``, ``bool(x)``)."""
+    (compiled,) = kernel.overloads.values()
+    return compiled.entry_point
+
+
+#: :func:`solve_one`, :func:`value_one` without the dispatcher (the runtime's scalar queries)
+solve_number, value_number = _machine_code(solve_one), _machine_code(value_one)
+
+
 @numba.njit(f"Tuple((float64, float64, int64))({_TABLE}, float64, float64, boolean)",
             cache=True, nogil=True)
 def slip_band_one(table, slip, load, allow):

@@ -7,7 +7,9 @@ Each (curve set, quantity) is packed once, at its first query, into one table
 (:func:`wpm_export.kernel.pack`): the curve parameters and their covariance as exact
 piecewise polynomials of load. Every query, one scalar or arrays of them, at any load, is
 then answered from that table by the compiled kernels of :mod:`wpm_export.kernel` (numba,
-imported at the first query). :meth:`WheelPerformanceModule.curve` alone builds the full
+imported at the first query): a query of numbers (a simulator's time step) by the kernel's
+machine code straight to floats, arrays in one kernel call.
+:meth:`WheelPerformanceModule.curve` alone builds the full
 :class:`fitting.load_interp.InterpolatedCurve` (with its fit diagnostics) from the tested
 curves.
 """
@@ -29,9 +31,9 @@ from wpm_export.schema import UNITS, WpmSelectionError
 CurveSet = tuple[str, str, int]  # (soil, wheel, multipass)
 #: status text by kernel code (status + 4 when the load was extrapolated)
 STATUS = ("ok", "above_max", "below_min", "at_step") * 2
-_STATUS_0D = {s: np.array(s, dtype="<U9") for s in STATUS[:4]}  # shared, read-only
-for _status in _STATUS_0D.values():
-    _status.flags.writeable = False
+#: a query of one number (Python's or NumPy's): answered as floats; anything else as arrays
+NUMBER = (float, int, np.floating, np.integer)
+_solution = tuple.__new__  # SlipSolution(slip, value, status) without its checked __new__
 
 
 def _selection_text(soil, wheel, multipass) -> str:
@@ -146,9 +148,12 @@ class WheelPerformanceModule:
         """Raise for an error code of the kernel (the message names the keyword argument),
         else warn that ``count`` loads were extrapolated."""
         k, tested = self._kernel, self._tested(table)
+        if isinstance(load_n, NUMBER):  # NumPy's numbers, ints: as the C library prints them
+            load_n = float(load_n)
+        value = _shown(value)
         span = f"{tested[0]:g}-{tested[-1]:g} N" if tested.size > 1 else f"{tested[0]:g} N"
         if code == k.BAD_TARGET or code == k.BAD_SLIP:
-            raise ValueError(f"{name}={value!r}: {quantity} queries need a finite number")
+            raise ValueError(f"{name}={value}: {quantity} queries need a finite number")
         if code == k.BAD_LOAD:
             raise LoadRangeError(f"load_n={load_n!r}: the wheel load must be a finite number "
                                  "> 0 N")
@@ -184,8 +189,7 @@ class WheelPerformanceModule:
         output arrays, status codes of the inverse)."""
         table = self._table(quantity, *selection)
         k = self._kernel
-        x, load = np.broadcast_arrays(np.asarray(x, dtype=float),
-                                      np.asarray(load_n, dtype=float))
+        x, load = np.broadcast_arrays(*_numbers(x, load_n, "target" if mode is None else "slip"))
         shape = x.shape
         x, load = np.array(x.ravel()), np.array(load.ravel())  # contiguous, writable copies
         out = np.empty(x.size), np.empty(x.size), np.empty(x.size)
@@ -226,70 +230,62 @@ class WheelPerformanceModule:
         return out
 
     def band(self, quantity: str, slip, load_n, *, soil=None, wheel=None, multipass=None,
-             allow_extrapolation: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(value, conf_half95, pred_half95)`` of ``quantity`` at ``slip`` and ``load_n``
-        (broadcast together), as :func:`fitting.band` of :meth:`curve` gives them: the 95 %
-        half-widths of the true curve and of one new run's mean (NaN where the file carries
-        no uncertainty). No warning outside the fitted slip range."""
+             allow_extrapolation: bool = False) -> tuple:
+        """``(value, conf_half95, pred_half95)`` of ``quantity`` at ``slip`` and ``load_n``,
+        as :func:`fitting.band` of :meth:`curve` gives them: the 95 % half-widths of the true
+        curve and of one new run's mean (NaN where the file carries no uncertainty). Two
+        numbers (a simulator's time step): three floats; arrays (broadcast together, 0-d
+        included): three arrays. No warning outside the fitted slip range."""
+        if isinstance(slip, NUMBER) and isinstance(load_n, NUMBER):
+            table = self._packed.get((quantity, soil, wheel, multipass))
+            if table is None:
+                table = self._table(quantity, soil, wheel, multipass)
+            try:
+                value, conf, pred, code = self._kernel.value_number(table, slip, load_n,
+                                                                    allow_extrapolation)
+            except (TypeError, OverflowError):  # e.g. an int beyond the doubles
+                raise TypeError(f"slip={_shown(slip)}, load_n={_shown(load_n)}: numbers "
+                                "expected") from None
+            if code:
+                self._outcome(code, quantity, table, load_n, slip, "slip")
+            return value, conf, pred
         shape, out, _ = self._many(quantity, slip, load_n, (soil, wheel, multipass),
                                    allow_extrapolation, "BANDS")
         return tuple(a.reshape(shape) for a in out)
 
-    def band_one(self, quantity: str, slip: float, load_n: float, *, soil=None, wheel=None,
-                 multipass=None, allow_extrapolation: bool = False
-                 ) -> tuple[float, float, float]:
-        """:meth:`band` of one slip at one load as floats: the call a simulator makes each
-        time step."""
-        table = self._packed.get((quantity, soil, wheel, multipass))
-        if table is None:
-            table = self._table(quantity, soil, wheel, multipass)
-        try:
-            value, conf, pred, code = self._kernel.value_one(table, slip, load_n,
-                                                             allow_extrapolation)
-        except TypeError:
-            raise TypeError(f"slip={slip!r}, load_n={load_n!r}: numbers expected") from None
-        if code:
-            self._outcome(code, quantity, table, load_n, slip, "slip")
-        return value, conf, pred
-
-    def slip_for_one(self, quantity: str, target: float, load_n: float, *, soil=None,
-                     wheel=None, multipass=None, allow_extrapolation: bool = False
-                     ) -> tuple[float, float, str]:
-        """:meth:`slip_for` of one target at one load as ``(slip, value, status)`` floats and
-        text: the call a simulator makes each time step, at whatever load."""
-        table = self._packed.get((quantity, soil, wheel, multipass))
-        if table is None:
-            table = self._table(quantity, soil, wheel, multipass)
-        try:
-            slip, value, code = self._kernel.solve_one(table, target, load_n,
-                                                       allow_extrapolation)
-        except TypeError:
-            raise TypeError(f"target={target!r}, load_n={load_n!r}: numbers expected") from None
-        if code < 0 or code >= 4:
-            self._outcome(code, quantity, table, load_n, target)
-        return slip, value, STATUS[code]
+    #: :meth:`band` (its name for one slip at one load since 0.14.0)
+    band_one = band
 
     def slip_for(self, quantity: str, target, load_n, *, soil=None, wheel=None, multipass=None,
                  allow_extrapolation: bool = False) -> SlipSolution:
-        """The smallest slip at which the wheel gives ``target`` of ``quantity`` at ``load_n``
-        (broadcast together); slip 1.0 and the maximum where the target is above the curve
-        (the maximum over the fitted slip range), slip 0.0 and status ``at_step`` where it
-        falls inside the jump at zero slip (:mod:`wpm_export.inverse`); ``value`` is the
-        target where it is reached. Exact to rounding (the root to 1e-14)."""
-        if isinstance(target, (float, int)) and isinstance(load_n, (float, int)):
+        """The smallest slip at which the wheel gives ``target`` of ``quantity`` at ``load_n``;
+        slip 1.0 and the maximum where the target is above the curve (the maximum over the
+        fitted slip range), slip 0.0 and status ``at_step`` where it falls inside the jump at
+        zero slip (:mod:`wpm_export.inverse`); ``value`` is the target where it is reached.
+        Exact to rounding (the root to 1e-14). Two numbers (a simulator's time step, at
+        whatever load): floats and the status text; arrays (broadcast together, 0-d
+        included): arrays."""
+        if isinstance(target, NUMBER) and isinstance(load_n, NUMBER):
             table = self._packed.get((quantity, soil, wheel, multipass))
             if table is None:
                 table = self._table(quantity, soil, wheel, multipass)
-            slip, value, code = self._kernel.solve_one(table, target, load_n,
-                                                       allow_extrapolation)
+            try:
+                slip, value, code = self._kernel.solve_number(table, target, load_n,
+                                                              allow_extrapolation)
+            except (TypeError, OverflowError):  # e.g. an int beyond the doubles
+                raise TypeError(f"target={_shown(target)}, load_n={_shown(load_n)}: numbers "
+                                "expected") from None
             if code < 0 or code >= 4:
                 self._outcome(code, quantity, table, load_n, target)
-            return SlipSolution.of(np.array(slip), np.array(value), _STATUS_0D[STATUS[code]])
+            return _solution(SlipSolution, (slip, value, STATUS[code]))
         shape, (slip, value, _), status = self._many(quantity, target, load_n,
                                                      (soil, wheel, multipass),
                                                      allow_extrapolation, None)
         return SlipSolution(slip=slip.reshape(shape), value=value.reshape(shape),
                             status=np.array(STATUS[:4], dtype="<U9")[status].reshape(shape))
+
+    #: :meth:`slip_for` (its name for one target at one load since 0.14.0)
+    slip_for_one = slip_for
 
     def slip_band(self, quantity: str, slip, load_n, *, soil=None, wheel=None,
                   multipass=None, allow_extrapolation: bool = False
@@ -298,7 +294,7 @@ class WheelPerformanceModule:
         curve's bands at that slip over its slope there, ``u_slip = u_y / |dy/ds|``
         (linearised; NaN where the curve has no uncertainty, inf where the slope is 0; NaN
         slips stay NaN); ``slip`` and ``load_n`` broadcast together."""
-        if isinstance(slip, (float, int)) and isinstance(load_n, (float, int)):
+        if isinstance(slip, NUMBER) and isinstance(load_n, NUMBER):
             table = self._table(quantity, soil, wheel, multipass)
             conf, pred, code = self._kernel.slip_band_one(table, slip, load_n,
                                                           allow_extrapolation)
@@ -309,3 +305,31 @@ class WheelPerformanceModule:
                                                (soil, wheel, multipass), allow_extrapolation,
                                                "SLIP_BANDS")
         return conf.reshape(shape), pred.reshape(shape)
+
+
+def _numbers(x, load_n, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """``x`` and ``load_n`` as float64 arrays (0-d for numbers); ``TypeError`` naming them for
+    text or anything else that is not numbers."""
+    try:
+        given = np.asarray(x), np.asarray(load_n)
+        if any(a.dtype.kind in "SUV" for a in given):
+            raise TypeError
+        return tuple(a.astype(float, copy=False) for a in given)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name}={_shown(x)}, load_n={_shown(load_n)}: numbers "
+                        "expected") from None
+
+
+def _shown(given) -> str:
+    """A query's argument in a message: a number as a float, other scalars as typed, arrays
+    by type and dtype."""
+    try:
+        array = np.asarray(given)
+    except ValueError:  # ragged nesting
+        return f"<{type(given).__name__}>"
+    if array.ndim:
+        return f"<{type(given).__name__} of {array.dtype}>"
+    try:
+        return repr(float(given)) if isinstance(given, NUMBER) else repr(given)
+    except OverflowError:  # an int beyond the doubles
+        return repr(given)
