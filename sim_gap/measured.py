@@ -8,7 +8,7 @@ model), ``multipass``, ``gravity_mps2``, ``slip`` and ``<q>``, ``<q>_se`` for th
 quantities of :data:`sim_gap.vocabulary.QUANTITIES` that the source has, and
 ``<q>_repeat_sd`` where the source measured its repeatability (:func:`sim_gap.fit.sigmas`).
 ``attrs``:
-``source`` (text), ``wheels`` (source -> its :class:`swtlab.domain.Wheel`), ``wheel`` (the
+``source`` (text), ``wheels`` (source -> its :class:`swtlab_base.domain.Wheel`), ``wheel`` (the
 one measured wheel, None when the sources have several), ``sinkage_relative`` (True when
 only sinkage differences are known, e.g. a hub height without an absolute zero).
 """

@@ -208,7 +208,7 @@ def _one_wheel_per_source(path: str, table: pd.DataFrame, numbers: list[int]) ->
 
 
 def wheel_of(row: pd.Series) -> Wheel:
-    """The :class:`swtlab.domain.Wheel` of a row of :func:`read_points_csv`."""
+    """The :class:`swtlab_base.domain.Wheel` of a row of :func:`read_points_csv`."""
     stiffness = row.get("wheel_stiffness_n_per_mm")
     return Wheel(radius_m=float(row["wheel_radius_m"]), width_m=float(row["wheel_width_m"]),
                  grouser_count=int(row["grouser_count"]),

@@ -1,5 +1,5 @@
 """The gap compares like with like: the measured wheel must be the simulated one (radius,
-width and grousers within the tolerances of :meth:`swtlab.domain.Wheel.mismatches`)."""
+width and grousers within the tolerances of :meth:`swtlab_base.domain.Wheel.mismatches`)."""
 
 from __future__ import annotations
 
