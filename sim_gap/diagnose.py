@@ -16,7 +16,7 @@ from threadpoolctl import threadpool_limits
 
 from sim_gap import candidates as cands
 from sim_gap.crossval import contrasts, cross_validate, folds
-from sim_gap.decide import by_effect, by_effect_set, decide, posterior
+from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate, posterior
 from sim_gap.discriminate import separating_test
 from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances, log_evidence,
                               observations)
@@ -250,14 +250,16 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
         candidate_of[key], fits[key], evidence[key] = c, base, e
     evidence[OUTSIDE] = _evidence(covariances(obs, amplitudes), obs, sim, fits["soil_only"])
     prior = hypothesis_priors(list(candidate_of.values()), len(allowed))
-    probability = posterior({k: e.log_evidence for k, e in evidence.items()}, prior)
+    best = max((k for k in evidence if k != OUTSIDE), key=lambda k: evidence[k].log_evidence)
+    eta = learning_rate(fits[best].fit.chi2, fits[best].fit.n_residuals, fits[best].fit.n_params)
+    probability = posterior({k: e.log_evidence for k, e in evidence.items()}, prior, eta)
     hypotheses = sorted(
         [_hypothesis(k, candidate_of.get(k), fits.get(k, fits["soil_only"]), evidence[k],
                      prior[k], probability[k]) for k in evidence],
         key=lambda h: -h["probability"])
     leaders = _leading_sets(hypotheses)
     separation = (_separation(sim, points, obs, fits, *leaders) if len(leaders) == 2 else None)
-    decision = decide(hypotheses, separation)
+    decision = decide(hypotheses, separation, eta)
     decision["reason"] += _discrepancy_text(points, sim, evidence[decision["chosen"]])
     chosen = fits[decision["chosen"]].fit
     if untestable and decision["verdict"] == []:

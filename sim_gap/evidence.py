@@ -48,7 +48,7 @@ import pandas as pd
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.special import log_ndtr, logsumexp
 
-from sim_gap.fit import quantities_of
+from sim_gap.fit import independent_entries, quantities_of
 from sim_gap.vocabulary import model_error_floor
 
 #: discrepancy length scales: a quarter of the slip range a campaign spans (-0.3 to 0.9), and
@@ -96,7 +96,7 @@ def observations(points: pd.DataFrame, sigma: dict[str, np.ndarray], radius_m: f
     """The flat observations of ``points`` with noise ``sigma`` (:func:`sim_gap.fit.sigmas`)."""
     quantities = quantities_of(points)
     values = points[quantities].to_numpy(float)
-    where = np.isfinite(values)
+    where = independent_entries(points)
     point, qi = np.nonzero(where)
     load = points["wheel_load_n"].to_numpy(float)
     floor_by_q = np.column_stack([model_error_floor(q, load, radius_m) for q in quantities])

@@ -25,6 +25,19 @@ def quantities_of(points: pd.DataFrame) -> list[str]:
     return [q for q in QUANTITIES if q in points]
 
 
+def independent_entries(points: pd.DataFrame) -> np.ndarray:
+    """Mask (points x :func:`quantities_of`) of the measured entries that carry information
+    of their own: every finite value, except a motion resistance measured beside both the
+    drawbar pull and the torque of its point, since ``R = T/r - DP`` is computed from them
+    (counting it again would weigh those two twice, and their errors with them)."""
+    quantities = quantities_of(points)
+    where = np.isfinite(points[quantities].to_numpy(float))
+    if {"resistance_n", "dp_n", "torque_nm"} <= set(quantities):
+        i = quantities.index
+        where[:, i("resistance_n")] &= ~(where[:, i("dp_n")] & where[:, i("torque_nm")])
+    return where
+
+
 def sigmas(points: pd.DataFrame, radius_m: float) -> dict[str, np.ndarray]:
     """Per-point uncertainty of each quantity for fitting. Where the point's source measured
     its run-to-run repeatability (``<q>_repeat_sd``: replicate runs, or the spread of a
@@ -71,7 +84,7 @@ def residual_function(sim: Simulated, points: pd.DataFrame, sigma: dict[str, np.
     with the points' columns read once: a fit evaluates it hundreds of times."""
     quantities = quantities_of(points)
     measured = points[quantities].to_numpy(float)
-    where = np.isfinite(measured)
+    where = independent_entries(points)
     relative = bool(points.attrs.get("sinkage_relative"))
     predict = sim.predictor(points)
     return lambda values: _standardised(measured, quantities, predict(values), sigma,
@@ -157,7 +170,7 @@ def fit_map(sim: Simulated, c: Candidate, points: pd.DataFrame, sigma: dict[str,
     u0 = np.clip(u0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
     residuals_at = residual_function(sim, points, sigma)
     measured = points[quantities_of(points)].to_numpy(float)
-    where = np.isfinite(measured)
+    where = independent_entries(points)
     scale = np.column_stack([sigma[q] for q in quantities_of(points)])[where]
 
     def data(u):

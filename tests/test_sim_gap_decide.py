@@ -11,7 +11,8 @@ from scipy import integrate, stats
 
 import terramechanics as tm
 from sim_gap import candidates
-from sim_gap.decide import CALL_PROBABILITY, by_effect_set, decide, posterior
+from sim_gap.decide import (CALL_PROBABILITY, by_effect_set, decide, learning_rate,
+                            posterior)
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.discriminate import separating_test
 from sim_gap.evidence import NUGGET_GRID, TAU_GRID, Observations, covariances, log_evidence
@@ -150,6 +151,20 @@ def test_posterior_sums_laws_and_calls_only_at_the_threshold():
         assert (sets["grousers"] >= CALL_PROBABILITY) == (verdict != "inconclusive")
         lead = by_effect_set(h)[0]["label"]
         assert d["chosen"] == {"grousers": "grousers(a)", "soil_only": "soil_only"}[lead]
+
+
+def test_learning_rate_tempers_the_evidence_not_the_prior():
+    """``P(H) Z^eta``: at eta = 0 the posterior is the prior, at eta = 1 Bayes' rule, in
+    between the log odds are the prior's plus eta times the log evidence ratio; eta is one
+    over the Pearson dispersion, at most one (worked by hand)."""
+    prior = {"a": 0.75, "b": 0.25}
+    logs = {"a": 0.0, "b": 10.0}
+    assert posterior(logs, prior, eta=0.0)["a"] == pytest.approx(0.75)
+    for eta in (0.16, 0.5, 1.0):
+        p = posterior(logs, prior, eta=eta)
+        assert np.log(p["b"] / p["a"]) == pytest.approx(np.log(0.25 / 0.75) + 10.0 * eta)
+    assert learning_rate(chi2=400.0, n_entries=104, n_params=4) == pytest.approx(0.25)
+    assert learning_rate(chi2=50.0, n_entries=104, n_params=4) == 1.0
 
 
 @pytest.mark.parametrize("effects, expected", [

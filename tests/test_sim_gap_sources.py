@@ -163,10 +163,14 @@ def test_ding_smooth_and_lug_wheel_on_one_soil(tmp_path):
     assert [s["wheel"]["grouser_count"] for s in d["sources"]] == [0, 30]
     assert d["wheel"]["simulated"] == "each source's own wheel"
     # what the data give (docs/gap-report.md): the lugs add drawbar pull beyond noise, and
-    # Ding et al. model these wheels with both lug effects and slip-sinkage; soil alone is
-    # ruled out, and no named call leaves the grousers out
+    # Ding et al. model these wheels with both lug effects and slip-sinkage; soil alone loses
+    # probability against its prior (by less than Bayes' rule would say: the fits miss these
+    # points by several times their noise, so the learning rate is below one), and no named
+    # call leaves the grousers out
     sets = {e["label"]: e["probability"] for e in d["effect_sets"]}
-    assert sets["soil_only"] < 0.01
+    soil = next(h for h in d["hypotheses"] if h["key"] == "soil_only")
+    assert d["learning_rate"] < 1.0
+    assert sets["soil_only"] < soil["prior"] / 2
     assert d["verdict"] in ("inconclusive", "outside_candidates") or "grousers" in d["verdict"]
     assert d["chosen"].startswith("grousers(")
     assert d["verdict"] != "inconclusive" or d["separating_test"]["test"]

@@ -33,6 +33,9 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import numpy as np
+from scipy.stats import beta
+
 from testbeds.apart.effects import SIX
 
 CLASSES = ("none", "single", "pair", "outside")
@@ -45,10 +48,11 @@ def _write(path: Path, text: str) -> None:
     os.replace(f.name, path)
 
 
-def diagnose(folder: Path, boot: int, redo: bool = False, regap: bool = False) -> float:
+def diagnose(folder: Path, boot: int, redo: bool = False, regap: bool = False,
+             process_only: bool = False) -> float:
     """``swtlab process`` then ``swtlab gap`` on one campaign folder; seconds taken.
     ``regap``: diagnose again from the databases already processed (a new diagnosis on the
-    same processed runs)."""
+    same processed runs); ``process_only``: process, do not diagnose."""
     start = time.perf_counter()
     gap, failure = folder / "gap.json", folder / "failure.txt"
     if gap.exists() and not (redo or regap):
@@ -68,6 +72,8 @@ def diagnose(folder: Path, boot: int, redo: bool = False, regap: bool = False) -
                                       "--quiet", "--jobs", "1"], check=True,
                                capture_output=True)
             measured += ["--measured", f"sqlite:///{db}"]
+        if process_only:
+            return time.perf_counter() - start
         step = "gap"
         subprocess.run(cli + ["gap", *measured, "--sim", str(folder / "sim.toml"), "--json",
                               str(gap), "--boot", str(boot)], check=True, capture_output=True)
@@ -110,7 +116,7 @@ def probabilities(report: dict) -> dict[tuple[str, ...] | str, float]:
     elif isinstance(raw, list):
         for entry in raw:
             if isinstance(entry, dict):
-                label = next((entry[k] for k in ("effects", "label", "hypothesis", "name")
+                label = next((entry[k] for k in ("label", "effects", "hypothesis", "name")
                               if k in entry), None)
                 p = next((entry[k] for k in ("probability", "p", "posterior") if k in entry),
                          None)
@@ -157,22 +163,76 @@ def score_campaign(folder: Path, truth: dict) -> dict:
         leading = max(probs, key=probs.get)
         row["leading"] = "+".join(leading) or "none" if isinstance(leading, tuple) else leading
         row["p_leading"] = probs[leading]
-        if not truth["outside"]:
-            row["p_true"] = probs.get(truth_set, 0.0)
+        row["p_true"] = probs.get("outside_candidates" if truth["outside"] else truth_set, 0.0)
     return row
+
+
+def leading_is_right(r: dict) -> bool | None:
+    """Whether the most probable hypothesis (effect set, or outside the candidates) is the
+    truth: the truth's six exactly, or outside the candidates for a campaign with an effect
+    outside the six. None without probabilities."""
+    if r["p_leading"] is None:
+        return None
+    if r["outside"]:
+        return r["leading"] == "outside_candidates"
+    return r["leading"] == ("+".join(e for e in SIX if e in r["effects"]) or "none")
+
+
+def upper_95(k: int, n: int) -> float:
+    """One-sided 95 % upper bound of a rate seen ``k`` times in ``n`` (Clopper & Pearson
+    1934, exact)."""
+    return 1.0 if n == 0 or k >= n else float(beta.ppf(0.95, k + 1, n - k))
+
+
+def calibration(rows: list[dict]) -> dict:
+    """Reliability of the stated probabilities: per decile of the leading hypothesis'
+    probability, how many campaigns, their mean stated probability and the fraction whose
+    leading hypothesis is the truth; confident wrong calls (a named verdict, probability >=
+    0.9, that is not the truth) with their 95 % upper bound; the issue's rates."""
+    scored = [r for r in rows if r["p_leading"] is not None]
+    bins = []
+    for lo in np.arange(0.0, 1.0, 0.1):
+        sub = [r for r in scored if lo <= r["p_leading"] < lo + 0.1 or (lo >= 0.9 and
+                                                                    r["p_leading"] >= 1.0)]
+        right = [bool(leading_is_right(r)) for r in sub]
+        bins.append({"bin": f"{lo:.1f}-{lo + 0.1:.1f}", "n": len(sub),
+                     "stated": float(np.mean([r["p_leading"] for r in sub])) if sub else None,
+                     "right": float(np.mean(right)) if sub else None})
+    n = len(rows)
+    wrong = sum(r["outcome"] == "wrong" for r in rows)
+
+    def rate(cls, outcome):
+        sub = [r for r in rows if r["class"] in cls]
+        return (sum(r["outcome"] == outcome for r in sub), len(sub))
+
+    p_true = np.array([r["p_true"] for r in scored], float)
+    return {"bins": bins, "confident_wrong": wrong, "n": n,
+            "log_loss": float(np.mean(-np.log(np.maximum(p_true, 1e-12)))) if scored else None,
+            "confident_wrong_upper_95": upper_95(wrong, n),
+            "right_none_and_singles": rate(("none", "single"), "right"),
+            "right_pairs": rate(("pair",), "right"),
+            "outside_not_named": rate(("outside",), "right")}
 
 
 def score(out: Path) -> dict:
     """Rows of every campaign with a truth file under ``out`` and the counts per class."""
     rows = [score_campaign(out / path.stem, json.loads(path.read_text()))
             for path in sorted((out / "truth").glob("c*.json"))]
+    for r in rows:
+        r["campaign"] = f"{out.name}/{r['campaign']}"
+    return summarise(rows)
+
+
+def summarise(rows: list[dict]) -> dict:
+    """The counts per class and the calibration of ``rows``."""
     by_class = {}
     for cls in CLASSES:
         sub = [r for r in rows if r["class"] == cls]
         by_class[cls] = {"n": len(sub)} | {k: sum(r["outcome"] == k for r in sub)
                                             for k in ("right", "inconclusive", "wrong", "failed")}
         by_class[cls]["chosen_is_truth"] = sum(bool(r.get("chosen_is_truth")) for r in sub)
-    return {"n": len(rows), "by_class": by_class, "campaigns": rows}
+    return {"n": len(rows), "by_class": by_class, "calibration": calibration(rows),
+            "campaigns": rows}
 
 
 def _label(r: dict) -> str:
@@ -196,28 +256,59 @@ def markdown(result: dict) -> str:
         if v["n"]:
             lines.append(f"| {cls} | {v['n']} | {v['right']} | {v['inconclusive']} | "
                          f"{v['wrong']} | {v['failed']} | {v['chosen_is_truth']} |")
+    return "\n".join(lines + ["", calibration_markdown(result["calibration"])])
+
+
+def calibration_markdown(cal: dict) -> str:
+    """The reliability table and the issue's rates, in Markdown."""
+    lines = ["| stated probability of the leading hypothesis | campaigns | mean stated | "
+             "leading is the truth |", "|---|---|---|---|"]
+    for b in cal["bins"]:
+        if b["n"]:
+            lines.append(f"| {b['bin']} | {b['n']} | {b['stated']:.2f} | {b['right']:.2f} |")
+
+    def frac(pair):
+        k, n = pair
+        return f"{k}/{n} ({100 * k / n:.0f} %)" if n else "-"
+
+    lines += ["", f"- confident wrong (a named verdict that is not the truth): "
+              f"{frac((cal['confident_wrong'], cal['n']))}, 95 % upper bound "
+              f"{100 * cal['confident_wrong_upper_95']:.1f} %",
+              f"- mean log loss of the true hypothesis (nats; lower is better): "
+              f"{cal['log_loss']:.2f}" if cal["log_loss"] is not None else "- no probabilities",
+              f"- right on none and singles: {frac(cal['right_none_and_singles'])}",
+              f"- right on pairs: {frac(cal['right_pairs'])}",
+              f"- an effect outside the six not named as one of the six: "
+              f"{frac(cal['outside_not_named'])}"]
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m testbeds.apart.score",
                                      description=__doc__.split("\n\n")[0])
-    parser.add_argument("out", type=Path, help="folder written by testbeds.apart.campaigns")
+    parser.add_argument("out", type=Path, nargs="+",
+                        help="folders written by testbeds.apart.campaigns (scored together)")
     parser.add_argument("--jobs", type=int, default=1, help="campaigns diagnosed at a time")
     parser.add_argument("--boot", type=int, default=50, help="swtlab gap --boot")
     parser.add_argument("--redo", action="store_true", help="diagnose again where a report is")
     parser.add_argument("--regap", action="store_true",
                         help="run swtlab gap again on the databases already processed")
+    parser.add_argument("--process-only", action="store_true",
+                        help="process the runs into the databases, diagnose nothing")
     parser.add_argument("--json", type=Path, help="write the scores here")
     parser.add_argument("--markdown", action="store_true", help="print Markdown tables")
     args = parser.parse_args(argv)
-    folders = [args.out / p.stem for p in sorted((args.out / "truth").glob("c*.json"))]
+    folders = [out / p.stem for out in args.out for p in sorted((out / "truth").glob("c*.json"))]
     if not folders:
-        parser.error(f"{args.out}: no campaign (truth/cNNN.json) found")
+        parser.error(f"{' '.join(map(str, args.out))}: no campaign (truth/cNNN.json) found")
     start = time.perf_counter()
     with ThreadPoolExecutor(max(args.jobs, 1)) as pool:
-        list(pool.map(lambda f: diagnose(f, args.boot, args.redo, args.regap), folders))
-    result = score(args.out)
+        list(pool.map(lambda f: diagnose(f, args.boot, args.redo, args.regap,
+                                         args.process_only), folders))
+    if args.process_only:
+        print(f"{len(folders)} campaigns processed, {time.perf_counter() - start:.0f} s")
+        return 0
+    result = summarise([r for out in args.out for r in score(out)["campaigns"]])
     result["seconds"] = time.perf_counter() - start
     if args.json:
         _write(args.json, json.dumps(result, indent=1) + "\n")
