@@ -30,7 +30,8 @@ def _installed() -> set[str]:
     """The top-level packages `pip install swtlab` installs (folders of this checkout)."""
     include = PYPROJECT["tool"]["setuptools"]["packages"]["find"]["include"]
     return {p.name for p in ROOT.iterdir()
-            if p.is_dir() and any(fnmatch(p.name, pattern) for pattern in include)}
+            if (p / "__init__.py").is_file() and any(fnmatch(p.name, pattern)
+                                                     for pattern in include)}
 
 
 def test_import_contracts_kept():
