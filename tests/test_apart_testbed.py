@@ -340,3 +340,47 @@ def test_a_lugged_wheel_runs_steady_for_four_grouser_periods():
         period = 2 * math.pi * w.radius_m / (w.grouser_count * slowest)
         steady = tl.decel_start_s - tl.motion_start_s - tl.settle_s
         assert steady >= max(4 * period, 14.5) - 1e-9
+
+
+def test_confident_wrong_upper_bound_is_clopper_pearsons():
+    """The 95 % upper bound of a rate seen k times in n: the rate at which seeing k or fewer
+    has probability 5 % (the binomial's own cdf, solved here by bisection)."""
+    from scipy.stats import binom
+
+    from testbeds.apart.score import upper_95
+
+    for k, n in ((0, 208), (3, 208), (10, 112)):
+        lo, hi = 0.0, 1.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if binom.cdf(k, n, mid) > 0.05 else (lo, mid)
+        assert upper_95(k, n) == pytest.approx(lo, abs=1e-9)
+    assert upper_95(0, 208) == pytest.approx(1 - 0.05 ** (1 / 208))
+
+
+def test_reliability_bins_count_each_campaign_once():
+    from testbeds.apart.score import calibration
+
+    rows = [{"class": "single", "outcome": "right" if i % 3 else "wrong", "outside": [],
+             "effects": ["grousers"], "leading": "grousers" if i % 3 else "none",
+             "p_leading": p, "p_true": p if i % 3 else 1 - p}
+            for i, p in enumerate(np.linspace(0.3, 1.0, 30))]
+    cal = calibration(rows)
+    assert sum(b["n"] for b in cal["bins"]) == 30
+    assert cal["confident_wrong"] == 10
+    top = cal["bins"][-1]
+    assert top["right"] == pytest.approx(np.mean([bool(i % 3) for i, p in enumerate(
+        np.linspace(0.3, 1.0, 30)) if p >= 0.9]))
+
+
+@pytest.mark.slow  # three campaigns through swtlab process and swtlab gap: about half a minute idle
+def test_calibration_bench_runs_the_full_chain_on_a_subset(tmp_path):
+    """Plumbing of ``python -m bench gap_calibration`` on three campaigns of a seed kept for
+    this test (9001): every campaign written, processed, diagnosed and scored."""
+    from bench.bench_gap_calibration import run
+
+    result = run(tmp_path, (9001,), 3, jobs=1)
+    assert result["n"] == 3
+    assert all(r["outcome"] != "failed" for r in result["campaigns"]), result["campaigns"]
+    assert sum(b["n"] for b in result["calibration"]["bins"]) == 3
+    assert all(0.0 <= r["p_true"] <= 1.0 for r in result["campaigns"])
