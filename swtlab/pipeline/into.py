@@ -7,6 +7,7 @@ stored, and the next call finishes it without duplicates).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -127,8 +128,9 @@ def process_into(db_url: str, folder: str | Path, channel_map: str | None = None
         f"{row.path} (run {row.run.run_id})" for row in mark_missing(session, folder)])
     changed = {r.result.condition.get("campaign") for r in pooled}
     again = [(p, c) for p, c, campaign in current if campaign in changed]
-    if again:  # their campaign's pool changed: their budgets are read again (results kept)
-        pooled += [r for r in process_files([p for p, _ in again], settings, jobs,
+    if again:  # their campaign's pool changed: their budgets are made again (no soil flow)
+        pooled += [r for r in process_files([p for p, _ in again],
+                                             dataclasses.replace(settings, max_frames=0), jobs,
                                              client=client, contents=[c for _, c in again],
                                              keep_samples=False) if r.result is not None]
     if pooled:
