@@ -9,8 +9,10 @@ The top layer: it chains the stages, and no stage imports it (the domain model e
 shares is :mod:`swtlab_base.domain`).
 """
 
-from swtlab.pipeline import (Campaign, Curves, GapReport, diagnose_gap, export_wpm,
-                             fit_curves, load, process_campaign, read_wpm, report, store)
+from swtlab.pipeline import (Campaign, Curves, GapReport, StoredBatch, diagnose_gap,
+                             export_from_database, export_wpm, fit_curves, load,
+                             process_campaign, process_into, query_wpm, read_wpm, report, store)
 
-__all__ = ["Campaign", "Curves", "GapReport", "diagnose_gap", "export_wpm", "fit_curves", "load",
-           "process_campaign", "read_wpm", "report", "store"]
+__all__ = ["Campaign", "Curves", "GapReport", "StoredBatch", "diagnose_gap",
+           "export_from_database", "export_wpm", "fit_curves", "load", "process_campaign",
+           "process_into", "query_wpm", "read_wpm", "report", "store"]

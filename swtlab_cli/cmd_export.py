@@ -41,35 +41,19 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from fitting import FittingError
-    from swtlab.pipeline.curves import export_wpm, fit_curves
-    from traceability import open_database
-    from traceability.database import in_transaction
-    from traceability.queries import latest_results
-    from traceability.store_fits import store_export, store_fits
-    from wpm_export.schema import FORMAT
+    from swtlab.pipeline.curves import export_from_database
 
     statuses = ("ok", "flagged") if args.include_flagged else ("ok",)
-    session_factory = open_database(args.db, create=False)
-    with session_factory() as session:
-        table = latest_results(session)
-    try:
-        curves = fit_curves(table, degree=args.degree, statuses=statuses)
+    try:  # the file is renamed into place before it is recorded
+        curves, file_hash = export_from_database(args.db, args.output, degree=args.degree,
+                                                 statuses=statuses)
     except (FittingError, ValueError) as error:
         print(f"swtlab export: {args.db}: {error}", file=sys.stderr)
         return exit_codes.BAD_INPUT
-    try:
-        file_hash = export_wpm(curves, args.output)  # renamed into place before it is recorded
     except OSError as error:
         print(f"swtlab export: cannot write {args.output}: {error.strerror or error}",
               file=sys.stderr)
         return exit_codes.BAD_INPUT
-
-    def record(session) -> None:
-        stored = store_fits(session, curves.table, curves.fits, curves.options)
-        store_export(session, args.output, file_hash, curves.inputs_sha256, FORMAT, stored,
-                     curves.options)
-
-    in_transaction(session_factory, record)
     for error in curves.not_fitted:
         print(f"  not fitted: {error}")
     print(f"{len(curves.fits)} curves from {len(curves.table)} runs written to {args.output} "

@@ -76,25 +76,21 @@ def run(args: argparse.Namespace) -> int:
     except (KeyError, ValueError) as exc:
         print(f"swtlab gap: --laws: {exc}", file=sys.stderr)
         return exit_codes.USAGE
+    from sim_gap.measured import is_database
+
+    measured = args.measured[0] if len(args.measured) == 1 else args.measured
     try:
-        measured = args.measured[0] if len(args.measured) == 1 else args.measured
         gap = diagnose_gap(measured, args.sim, effects=effects,
                            reference_model=args.reference_model, n_boot=args.boot,
                            jobs=args.jobs, seed=args.seed, laws=laws,
-                           allow_wheel_mismatch=args.allow_wheel_mismatch)
+                           allow_wheel_mismatch=args.allow_wheel_mismatch,
+                           record_in=measured if isinstance(measured, str)
+                           and is_database(measured) else None)  # recorded there too
         gap.write(args.json, args.html)
     except (OSError, ValueError, KeyError) as exc:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     report = gap.to_dict()
-    from sim_gap.measured import is_database
-
-    if len(args.measured) == 1 and is_database(args.measured[0]):  # recorded there too
-        from traceability import open_database
-        from traceability.store_gap import store_gap_report
-
-        with open_database(args.measured[0], create=False).begin() as session:
-            store_gap_report(session, report)
     for line in report["wheel"]["mismatches"]:
         print(f"wheel mismatch allowed: {line}")
     if len(report["sources"]) > 1:

@@ -98,91 +98,38 @@ def _where(db: str) -> str:
 
 def run(args: argparse.Namespace) -> int:
     import ingest
-    from swtlab.pipeline.database import store_one
+    from swtlab.pipeline.into import process_into
     from swtlab_base.cluster import connect
     from swtlab_base.cores import available_cores
-    from swtlab.pipeline.process import (ProcessSettings, budget_params, find_runs,
-                                         process_files, rig_compliance)
-    from traceability import open_database
-    from traceability.database import in_transaction
-    from traceability.hashing import content_sha256
-    from traceability.store import mark_missing
-    from traceability.store_flow import stored_flow_failure
-    from traceability.store_results import params_sha256, processed_file, replace_uncertainty
-    from run_results.uncertainty_budget import pool_drift
 
     try:
-        paths = find_runs(args.campaign, args.channel_map)
-        settings = ProcessSettings(channel_map=args.channel_map,
-                                   rig=rig_compliance(args.campaign, args.rig_compliance),
-                                   budget=budget_params(args.campaign))
         client = connect(args.dask) if args.dask else None
+    except (OSError, ValueError) as error:
+        print(f"swtlab process: {as_flags(str(error), args)}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
+    try:
+        batch = process_into(args.db, args.campaign, args.channel_map,
+                             args.jobs or available_cores(),
+                             rig_compliance_file=args.rig_compliance,
+                             allow_run_id_reuse=args.allow_run_id_reuse, client=client,
+                             progress=lambda runs, total: progress(
+                                 runs, desc="process", total=total, quiet=args.quiet))
     except (OSError, ValueError, tomllib.TOMLDecodeError, ingest.IngestError) as error:
         print(f"swtlab process: {as_flags(str(error), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
-    parameters = settings.parameters()
-    params_hash = params_sha256(parameters)
-    session_factory = open_database(args.db)
-    statuses: dict[str, list[str]] = {"ok": [], "flagged": [], "no_stable_phase": []}
-    failed: list[str] = []
-    flow_failed: list[str] = []
-    flows = up_to_date = 0
-    new: list[tuple] = []   # (path, sha256, result) stored now: their drift is pooled below
-    todo: list[tuple] = []  # (path, (sha256, size) or None): not yet processed
-    for path in paths:
-        try:
-            content = content_sha256(path)
-        except OSError:
-            content = None  # unreadable: process_file records why
-
-        def known(session, path=path, sha256=content and content[0]):
-            if sha256 is None or not processed_file(session, path, sha256, params_hash):
-                return None
-            failure = stored_flow_failure(session, path, sha256, params_hash)
-            return [] if failure is None else [f"{path}: {failure.channel}: {failure.problem}"]
-
-        known_flow_failures = in_transaction(session_factory, known)
-        if known_flow_failures is not None:
-            up_to_date += 1
-            flow_failed += known_flow_failures
-        else:
-            todo.append((path, content))
-    # computed by the workers (outside any transaction: no lock held), stored here in order
-    computed = process_files([p for p, _ in todo], settings, args.jobs or available_cores(),
-                             client=client, contents=[c for _, c in todo], keep_samples=False)
-    try:
-        for processed in progress(computed, desc="process", total=len(todo), quiet=args.quiet):
-            stored = store_one(session_factory, processed, parameters,
-                               allow_run_id_reuse=args.allow_run_id_reuse)
-            failed += [f.reason if f.error_type == "IngestError"
-                       else f"{f.file}: {f.stage}: {f.reason}"
-                       for f in processed.failures if f.stage != "soil_flow"]
-            if processed.result is None or any(f.stage == "store" for f in processed.failures):
-                continue
-            if not stored:
-                up_to_date += 1
-                continue
-            result = processed.result
-            new.append((processed.path, processed.sha256, result))
-            flows += processed.flow is not None
-            flow_failed += [f"{processed.run.source}: /camera/side: {f.reason}"
-                            for f in processed.failures if f.stage == "soil_flow"]
-            reasons = "; ".join(result.flags)
-            statuses.setdefault(result.status, []).append(
-                f"{result.run_id}: {reasons}" if reasons else result.run_id)
     finally:
         if client is not None:
             client.close()
-    missing = in_transaction(session_factory, lambda session: [
-        f"{row.path} (run {row.run.run_id})" for row in mark_missing(session, args.campaign)])
-    if new:
-        def store_pooled(session):
-            for (path, sha256, _), pooled in zip(new, pool_drift([r for *_, r in new])):
-                replace_uncertainty(session, path, sha256, params_hash, pooled.uncertainty)
-
-        in_transaction(session_factory, store_pooled)
-    done = sum(len(v) for v in statuses.values())
-    print(f"processed {done} of {len(paths)} runs ({up_to_date} already up to date): "
+    statuses: dict[str, list[str]] = {"ok": [], "flagged": [], "no_stable_phase": []}
+    for processed in batch.stored:
+        result = processed.result
+        reasons = "; ".join(result.flags)
+        statuses.setdefault(result.status, []).append(
+            f"{result.run_id}: {reasons}" if reasons else result.run_id)
+    failed = [f.reason if f.error_type == "IngestError" else f"{f.file}: {f.stage}: {f.reason}"
+              for f in batch.failures]
+    done = len(batch.stored)
+    print(f"processed {done} of {batch.found} runs ({batch.up_to_date} already up to date): "
           f"{len(statuses['ok'])} ok, {len(statuses['flagged'])} flagged, "
           f"{len(statuses['no_stable_phase'])} without a stable phase, {len(failed)} failed")
     for status in ("flagged", "no_stable_phase"):
@@ -190,13 +137,14 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {status}: {line}")
     for line in failed:
         print(f"  failed: {as_flags(line, args)}")
-    for line in missing:
+    for line in batch.missing:
         print(f"  missing: {line}: stored, but no longer in {args.campaign}; its results stay "
               "listed, marked raw_file_missing")
-    if flows or flow_failed:
-        print(f"soil flow under the wheel (side camera): measured in {flows} runs"
-              + (f", not measured in {len(flow_failed)}" if flow_failed else ""))
-    for line in flow_failed:
+    if batch.flows or batch.flow_failures:
+        print(f"soil flow under the wheel (side camera): measured in {batch.flows} runs"
+              + (f", not measured in {len(batch.flow_failures)}" if batch.flow_failures
+                 else ""))
+    for line in batch.flow_failures:
         print(f"  soil flow not measured: {line}")
     print(f"database: {_where(args.db)}  (list the results: swtlab results --db {args.db})")
-    return exit_codes.OK if done + up_to_date else exit_codes.BAD_INPUT
+    return exit_codes.OK if done + batch.up_to_date else exit_codes.BAD_INPUT

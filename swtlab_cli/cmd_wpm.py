@@ -12,7 +12,6 @@ import warnings
 
 from swtlab_cli import exit_codes
 from swtlab_cli.flags import as_flags
-from wpm_export.schema import UNITS
 
 #: option -> quantity of the inverse query
 TARGETS = {"dp": "dp_n", "torque": "torque_nm", "sinkage": "sinkage_m",
@@ -85,70 +84,6 @@ def run_fmu(args: argparse.Namespace) -> int:
     return exit_codes.OK
 
 
-def _inverse(wpm, args, chosen: dict) -> dict:
-    from fitting.band import band
-
-    option = next(o for o in TARGETS if getattr(args, o) is not None)
-    quantity, target = TARGETS[option], getattr(args, option)
-    extrapolate = {"allow_extrapolation": args.allow_extrapolation}
-    found = wpm.slip_for(quantity, target, args.load_n, **chosen, **extrapolate)
-    curve = wpm.curve(quantity, args.load_n, **chosen, **extrapolate)
-    slip = float(found.slip)
-    uncertainty = {"slip_conf_half95": None, "slip_pred_half95": None,
-                   "value_conf_half95": None, "value_pred_half95": None}
-    if curve.covariance is not None and str(found.status) in ("ok", "above_max"):
-        at = slip if str(found.status) == "ok" else _argmax(curve)
-        _, conf, pred = band(curve, at)
-        uncertainty.update(value_conf_half95=float(conf), value_pred_half95=float(pred))
-        if str(found.status) == "ok":
-            slip_conf, slip_pred = wpm.slip_band(quantity, slip, args.load_n, **chosen,
-                                                 **extrapolate)
-            uncertainty.update(slip_conf_half95=_finite(slip_conf),
-                               slip_pred_half95=_finite(slip_pred))
-    return {"quantity": quantity, "unit": UNITS[quantity], "target": target,
-            "slip": slip if slip == slip else None,  # NaN (below the curve) -> null
-            "value": float(found.value), "status": str(found.status),
-            "uncertainty_known": curve.covariance is not None, **uncertainty,
-            "slip_min": curve.slip_min, "slip_max": curve.slip_max, "method": curve.method,
-            "tested_loads_n": list(curve.tested_loads_n), "extrapolated_load": curve.extrapolated}
-
-
-def _finite(x) -> float | None:
-    """A finite float, else None (JSON null: a zero slope leaves the slip undetermined)."""
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-def _argmax(curve) -> float:
-    """The slip of the curve's maximum over its fitted range (dense grid)."""
-    import numpy as np
-
-    s = np.linspace(curve.slip_min, curve.slip_max, 4001)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return float(s[np.argmax(curve.evaluate(s))])
-
-
-def _values(wpm, args, chosen: dict) -> dict:
-    from fitting.band import band
-
-    out = {"slip": args.slip, "values": {}, "units": {}, "outside_slip_range": {},
-           "conf_half95": {}, "pred_half95": {}}
-    for quantity in wpm.quantities(**chosen):
-        curve = wpm.curve(quantity, args.load_n, **chosen,
-                          allow_extrapolation=args.allow_extrapolation)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            out["values"][quantity] = float(curve.evaluate(args.slip))
-        _, conf, pred = band(curve, args.slip)
-        out["conf_half95"][quantity], out["pred_half95"][quantity] = _finite(conf), _finite(pred)
-        out["units"][quantity] = UNITS[quantity]
-        out["outside_slip_range"][quantity] = bool(curve.outside_range(args.slip))
-        out.update(method=curve.method, tested_loads_n=list(curve.tested_loads_n),
-                   extrapolated_load=curve.extrapolated)
-    return out
-
-
 def _print_text(answer: dict) -> None:
     head = (f"{answer['soil']} / {answer['wheel']} / multipass {answer['multipass']} at "
             f"{answer['load_n']:g} N ({answer['method']} across {answer['tested_loads_n']} N"
@@ -199,23 +134,24 @@ def _slip_uncertainty(answer: dict) -> str:
 
 def run_query(args: argparse.Namespace) -> int:
     from fitting.errors import FittingError
-    from wpm_export import WheelPerformanceModule, WpmFormatError, WpmSelectionError
+    from swtlab.pipeline.curves import query_wpm
+    from wpm_export import WpmFormatError, WpmSelectionError
 
+    option = next((o for o in TARGETS if getattr(args, o) is not None), None)
     try:
-        wpm = WheelPerformanceModule.load(args.wpm_csv)
-        soil, wheel, multipass = wpm.select(soil=args.soil, wheel=args.wheel,
-                                            multipass=args.multipass)
-        chosen = {"soil": soil, "wheel": wheel, "multipass": multipass}
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            answer = (_values if args.slip is not None else _inverse)(wpm, args, chosen)
+            answer = query_wpm(args.wpm_csv, args.load_n,
+                               quantity=TARGETS[option] if option else None,
+                               target=getattr(args, option) if option else None,
+                               slip=args.slip, soil=args.soil, wheel=args.wheel,
+                               multipass=args.multipass,
+                               allow_extrapolation=args.allow_extrapolation)
     except (OSError, WpmFormatError, WpmSelectionError, FittingError) as exc:
         print(f"swtlab wpm: {as_flags(str(exc), args)}", file=sys.stderr)
         return exit_codes.BAD_INPUT
     for w in {str(w.message) for w in caught}:
         print(f"swtlab wpm: warning: {w}", file=sys.stderr)
-    answer = {"file": args.wpm_csv, "soil": soil, "wheel": wheel, "multipass": multipass,
-              "load_n": args.load_n, **answer}
     if args.json:
         print(json.dumps(answer))
     else:

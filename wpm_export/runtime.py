@@ -307,6 +307,77 @@ class WheelPerformanceModule:
         return conf.reshape(shape), pred.reshape(shape)
 
 
+    def answer_for(self, quantity: str, target: float, load_n: float, *, soil=None,
+                   wheel=None, multipass=None, allow_extrapolation: bool = False) -> dict:
+        """:meth:`slip_for` of one ``target`` with its 95 % half-widths, as ``swtlab wpm
+        query --dp/--torque/...`` answers it (docs/wpm-csv.md): the slip's (:meth:`slip_band`)
+        where the target is reached, the value's (:func:`fitting.band`) there or, above the
+        curve, at the curve's maximum (:func:`max_slip`); JSON-ready (null: not defined)."""
+        from fitting.band import band
+
+        chosen = {"soil": soil, "wheel": wheel, "multipass": multipass,
+                  "allow_extrapolation": allow_extrapolation}
+        found = self.slip_for(quantity, target, load_n, **chosen)
+        curve = self.curve(quantity, load_n, **chosen)
+        slip = float(found.slip)
+        uncertainty = {"slip_conf_half95": None, "slip_pred_half95": None,
+                       "value_conf_half95": None, "value_pred_half95": None}
+        if curve.covariance is not None and str(found.status) in ("ok", "above_max"):
+            at = slip if str(found.status) == "ok" else max_slip(curve)
+            _, conf, pred = band(curve, at)
+            uncertainty.update(value_conf_half95=float(conf), value_pred_half95=float(pred))
+            if str(found.status) == "ok":
+                slip_conf, slip_pred = self.slip_band(quantity, slip, load_n, **chosen)
+                uncertainty.update(slip_conf_half95=_finite(slip_conf),
+                                   slip_pred_half95=_finite(slip_pred))
+        return {"quantity": quantity, "unit": UNITS[quantity], "target": target,
+                "slip": slip if slip == slip else None,  # NaN (below the curve) -> null
+                "value": float(found.value), "status": str(found.status),
+                "uncertainty_known": curve.covariance is not None, **uncertainty,
+                "slip_min": curve.slip_min, "slip_max": curve.slip_max, "method": curve.method,
+                "tested_loads_n": list(curve.tested_loads_n),
+                "extrapolated_load": curve.extrapolated}
+
+    def answer_at(self, slip: float, load_n: float, *, soil=None, wheel=None, multipass=None,
+                  allow_extrapolation: bool = False) -> dict:
+        """Every quantity at one ``slip`` with its 95 % half-widths (:func:`fitting.band`) and
+        whether the slip is outside its fitted range, as ``swtlab wpm query --slip`` answers
+        it; JSON-ready."""
+        from fitting.band import band
+
+        chosen = {"soil": soil, "wheel": wheel, "multipass": multipass}
+        out = {"slip": slip, "values": {}, "units": {}, "outside_slip_range": {},
+               "conf_half95": {}, "pred_half95": {}}
+        for quantity in self.quantities(**chosen):
+            curve = self.curve(quantity, load_n, **chosen,
+                               allow_extrapolation=allow_extrapolation)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                out["values"][quantity] = float(curve.evaluate(slip))
+            _, conf, pred = band(curve, slip)
+            out["conf_half95"][quantity], out["pred_half95"][quantity] = (_finite(conf),
+                                                                          _finite(pred))
+            out["units"][quantity] = UNITS[quantity]
+            out["outside_slip_range"][quantity] = bool(curve.outside_range(slip))
+            out.update(method=curve.method, tested_loads_n=list(curve.tested_loads_n),
+                       extrapolated_load=curve.extrapolated)
+        return out
+
+
+def max_slip(curve: InterpolatedCurve) -> float:
+    """The slip of the curve's maximum over its fitted range (a grid of 4001 slips)."""
+    s = np.linspace(curve.slip_min, curve.slip_max, 4001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return float(s[np.argmax(curve.evaluate(s))])
+
+
+def _finite(x) -> float | None:
+    """A finite float, else None (JSON null: a zero slope leaves the slip undetermined)."""
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
 def _numbers(x, load_n, name: str) -> tuple[np.ndarray, np.ndarray]:
     """``x`` and ``load_n`` as float64 arrays (0-d for numbers); ``TypeError`` naming them for
     text or anything else that is not numbers."""

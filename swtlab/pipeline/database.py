@@ -1,5 +1,5 @@
 """The database adapter: a :class:`Campaign` in (``store``), a :class:`Campaign` out
-(``load``). The only writer of processed runs: the CLI stores through
+(``load``). The only writer of processed runs: :func:`swtlab.process_into` stores through
 :func:`store_one` too."""
 
 from __future__ import annotations

@@ -80,7 +80,8 @@ def _simulated(simulation, reference_model):
 def diagnose_gap(measured, simulation, *, effects: list[str] | None = None,
                  reference_model: str | Path | None = None, n_boot: int = 200, jobs: int = 1,
                  seed: int = 0, laws: dict[str, tuple[str, ...]] | None = None,
-                 allow_wheel_mismatch: bool = False) -> GapReport:
+                 allow_wheel_mismatch: bool = False,
+                 record_in: str | None = None) -> GapReport:
     """Where the measurements and the simulation differ, which missing effect explains it and
     how far (docs/gap-report.md).
 
@@ -94,13 +95,21 @@ def diagnose_gap(measured, simulation, *, effects: list[str] | None = None,
     ``allow_wheel_mismatch``; sources of several wheels are each simulated with their own.
     ``n_boot`` bootstrap replicates, ``jobs`` worker processes; ``laws``: effect -> the laws
     its candidates may use (default: every law of the family; a verdict must hold under each,
-    docs/gap-report.md, "Laws").
+    docs/gap-report.md, "Laws"). ``record_in``: a database URL (the measured campaign's)
+    where the report is recorded, for ``swtlab report`` to show.
     """
     from sim_gap.api import gap_report
     from sim_gap.diagnose import Settings
 
     points, measured_label = _points(measured)
     sim, sim_label = _simulated(simulation, reference_model)
-    return GapReport(gap_report(points, sim, measured_label, sim_label, effects,
-                                Settings(n_boot=n_boot, jobs=jobs, seed=seed, laws=laws),
-                                allow_wheel_mismatch))
+    report = GapReport(gap_report(points, sim, measured_label, sim_label, effects,
+                                  Settings(n_boot=n_boot, jobs=jobs, seed=seed, laws=laws),
+                                  allow_wheel_mismatch))
+    if record_in is not None:
+        from traceability import open_database
+        from traceability.store_gap import store_gap_report
+
+        with open_database(record_in, create=False).begin() as session:
+            store_gap_report(session, report.data)
+    return report

@@ -1,7 +1,7 @@
 """Raw files -> per-run results: ``process_file`` (one run, the function every worker runs),
 ``process_files`` (many, in order: serially, on a process pool or on a dask.distributed
 cluster) and ``process_campaign`` (a folder). No database: whoever stores the runs is the
-one writer (docs/scale-out.md)."""
+one writer (docs/scale-out.md; ``swtlab.pipeline.into.process_into`` stores them)."""
 
 from __future__ import annotations
 
@@ -273,7 +273,9 @@ def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: i
     ``soil_flow=False`` skips the side-camera analysis; ``progress``: wraps the processed
     runs as they come (e.g. ``tqdm``); ``keep_samples=False``: the runs come back without
     their sample tables (see :func:`process_files`). A run that fails is in ``.failures`` and
-    the batch goes on.
+    the batch goes on. The load cells' drift diffusion of the uncertainty budgets is pooled
+    over every run processed (under ``folder``, or those of ``runs``) with a result, per
+    campaign (:func:`campaign_of`); :func:`swtlab.process_into` pools it the same way.
     """
     if jobs < 1:
         raise ValueError(f"jobs {jobs} must be >= 1")
