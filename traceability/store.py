@@ -21,6 +21,7 @@ from traceability.provenance import lock_sha256, swtlab_version
 from traceability.text import TextRefused, checked_name
 from traceability.models import (Calibration, Campaign, ProcessingRecord, RawFile, Run, Soil,
                                  TestCondition, Wheel)
+from swtlab_base.errors import InputError
 
 
 class StoreOutcome(enum.Enum):
@@ -30,7 +31,7 @@ class StoreOutcome(enum.Enum):
     UNCHANGED = "unchanged"
 
 
-class RunIdClaimed(ValueError):
+class RunIdClaimed(InputError, ValueError):
     """A file claims the run_id of a run stored from another file."""
 
 
