@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ingest.errors import IngestError, Problem
-from swtlab_base.domain import G0_MPS2, MODES, Wheel
+from swtlab_base.domain import G0_MPS2, MODES, TestCondition, Wheel
 from swtlab_base.domain.ranges import METADATA
 
 #: longest text of a bad value an error message quotes
@@ -34,19 +34,15 @@ _CAMERA_KEYS = {"px_per_m", "travel_direction", "wheel_center_px", "wheel_radius
 
 @dataclass(frozen=True)
 class RunInfo:
-    """``swt.run``. ``load_n`` is the set wheel load (spec key ``load_N``)."""
+    """``swt.run``: which run, of which campaign, wheel and soil, and its set point
+    ``condition`` (the spec's ``load_N`` is its ``load_set_n``, ``velocity_mps`` its
+    ``velocity_set_mps``)."""
 
     run_id: str
     campaign: str
     wheel: str
     soil: str
-    multipass: int
-    mode: str
-    load_n: float
-    slip_setpoint: float | None
-    velocity_mps: float
-    gravity_mps2: float = G0_MPS2
-    steer_deg: float | None = None
+    condition: TestCondition
     started_at: datetime | None = None
     #: set wheel surface speed r*omega, for rigs that impose it instead of slip (channel map)
     wheel_surface_speed_setpoint_mps: float | None = None
@@ -96,12 +92,10 @@ class RunMetadata:
         """Plain JSON-ready dict (datetimes as ISO strings, calibration keys as 'topic.field')."""
         from dataclasses import asdict
 
-        out = {}
-        for name in ("run", "wheel", "suspension", "camera", "camera_track"):
+        out: dict[str, Any] = {"run": _run_record(self.run)}
+        for name in ("wheel", "suspension", "camera", "camera_track"):
             part = getattr(self, name)
             out[name] = None if part is None else asdict(part)
-        if out["run"]["started_at"] is not None:
-            out["run"]["started_at"] = self.run.started_at.isoformat()
         out["zero"] = dict(self.zero)
         out["calibration"] = {f"{t}.{f}": {"gain": g, "offset": o}
                               for (t, f), (g, o) in self.calibration.items()}
@@ -161,6 +155,18 @@ class _Reader:
         return value
 
 
+def _run_record(info: RunInfo) -> dict[str, Any]:
+    """``swt.run`` as a flat record with the spec's key names in lower case (``load_n``,
+    ``velocity_mps``), the start time as ISO text: what ``swtlab inspect --json`` shows."""
+    c = info.condition
+    return {"run_id": info.run_id, "campaign": info.campaign, "wheel": info.wheel,
+            "soil": info.soil, "multipass": c.multipass, "mode": c.mode, "load_n": c.load_set_n,
+            "slip_setpoint": c.slip_setpoint, "velocity_mps": c.velocity_set_mps,
+            "gravity_mps2": c.gravity_mps2, "steer_deg": c.steer_deg,
+            "started_at": None if info.started_at is None else info.started_at.isoformat(),
+            "wheel_surface_speed_setpoint_mps": info.wheel_surface_speed_setpoint_mps}
+
+
 def _unknown_keys(name: str, values: Mapping[str, Any], known: set[str]) -> list[Problem]:
     return [Problem("warning", f"swt.{name}.{k}", "unknown metadata key, ignored")
             for k in sorted(set(values) - known)]
@@ -201,11 +207,13 @@ def _run_info(path: Path, values: Mapping[str, Any], form: str) -> RunInfo:
         started_at = None if started is None else datetime.fromisoformat(started)
     except ValueError:
         raise r.fail("started_at", f"{started!r} is not an ISO 8601 date-time") from None
+    condition = TestCondition(mode=mode, load_set_n=load_n, multipass=multipass,
+                              velocity_set_mps=velocity, slip_setpoint=slip,
+                              gravity_mps2=G0_MPS2 if gravity is None else gravity,
+                              steer_deg=steer)
     return RunInfo(run_id=r.text("run_id"), campaign=r.text("campaign"), wheel=r.text("wheel"),
-                   soil=r.text("soil"), multipass=multipass, mode=mode, load_n=load_n,
-                   slip_setpoint=slip, velocity_mps=velocity,
-                   gravity_mps2=G0_MPS2 if gravity is None else gravity, steer_deg=steer,
-                   started_at=started_at, wheel_surface_speed_setpoint_mps=surface_speed)
+                   soil=r.text("soil"), condition=condition, started_at=started_at,
+                   wheel_surface_speed_setpoint_mps=surface_speed)
 
 
 def _slip_from_speeds(surface_speed_mps: float, velocity_mps: float) -> float | None:
