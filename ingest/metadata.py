@@ -10,7 +10,7 @@ import math
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Literal, Mapping, overload
 
 from ingest.errors import IngestError, Problem
 from swtlab_base.domain import G0_MPS2, MODES, TestCondition, Wheel
@@ -133,8 +133,22 @@ class _Reader:
         except (TypeError, ValueError, OverflowError):
             raise self.fail(key, f"{_shown(value)} is not {kind}") from None
 
+    @overload
+    def text(self, key: str, required: Literal[True] = True) -> str: ...
+    @overload
+    def text(self, key: str, required: Literal[False]) -> str | None: ...
+    @overload
+    def text(self, key: str, required: bool) -> str | None: ...
+
     def text(self, key: str, required: bool = True) -> str | None:
         return self._get(key, required, lambda v: str(v).strip(), "text")
+
+    @overload
+    def number(self, key: str, required: Literal[True] = True) -> float: ...
+    @overload
+    def number(self, key: str, required: Literal[False]) -> float | None: ...
+    @overload
+    def number(self, key: str, required: bool) -> float | None: ...
 
     def number(self, key: str, required: bool = True) -> float | None:
         value = self._get(key, required, float, "a number")
@@ -142,11 +156,25 @@ class _Reader:
             raise self.fail(key, f"{_shown(value)} is not a finite number")
         return value
 
+    @overload
+    def integer(self, key: str, required: Literal[True] = True) -> int: ...
+    @overload
+    def integer(self, key: str, required: Literal[False]) -> int | None: ...
+    @overload
+    def integer(self, key: str, required: bool) -> int | None: ...
+
     def integer(self, key: str, required: bool = True) -> int | None:
         value = self.number(key, required)
         if value is not None and value != int(value):
             raise self.fail(key, f"{value!r} is not a whole number")
         return None if value is None else int(value)
+
+    @overload
+    def positive(self, key: str, required: Literal[True] = True) -> float: ...
+    @overload
+    def positive(self, key: str, required: Literal[False]) -> float | None: ...
+    @overload
+    def positive(self, key: str, required: bool) -> float | None: ...
 
     def positive(self, key: str, required: bool = True) -> float | None:
         value = self.number(key, required)
@@ -241,12 +269,13 @@ def _camera_info(path: Path, values: Mapping[str, Any], form: str) -> CameraInfo
     direction = r.text("travel_direction", required=False) or "+x"
     if direction not in ("+x", "-x"):
         raise r.fail("travel_direction", f"{direction!r}: use +x or -x")
-    centre = r.text("wheel_center_px", required=False)
-    if centre is not None:
+    centre_text = r.text("wheel_center_px", required=False)
+    centre = None
+    if centre_text is not None:
         try:
-            cx, cy = (float(v) for v in centre.strip("[]() ").split(","))
+            cx, cy = (float(v) for v in centre_text.strip("[]() ").split(","))
         except ValueError:
-            raise r.fail("wheel_center_px", f"{centre!r} is not 'x,y'") from None
+            raise r.fail("wheel_center_px", f"{centre_text!r} is not 'x,y'") from None
         centre = (cx, cy)
     return CameraInfo(px_per_m=r.positive("px_per_m"), travel_direction=direction,
                       wheel_center_px=centre,
