@@ -56,8 +56,7 @@ def nonsense(result) -> str | None:
             return f"{name}: non-finite statistic {values}"
         if stats.se == 0 and name in LOAD_CELL:
             return f"{name}: SE of 0"
-    c = result.condition
-    radius, load_set = c["wheel_radius_m"], c["load_n"]
+    radius, load_set = result.wheel.radius_m, result.condition.load_set_n
 
     def mean(name):
         return q[name].mean if name in q else None

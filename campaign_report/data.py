@@ -71,10 +71,10 @@ class RunRecord:
     def from_result(cls, result: ProcessedRun) -> RunRecord:
         """The record of an in-memory ``run_results.RunResult`` (``process_run``)."""
         c, w = result.condition, result.window
-        return cls(run_id=result.run_id, wheel=c["wheel"], soil=c["soil"], mode=result.mode,
-                   multipass=int(c["multipass"]), load_n=float(c["load_n"]),
-                   slip_setpoint=_none_if_nan(c.get("slip_setpoint")),
-                   velocity_mps=float(c["velocity_mps"]), status=result.status,
+        return cls(run_id=result.run_id, wheel=result.wheel.name, soil=result.soil,
+                   mode=c.mode, multipass=c.multipass, load_n=float(c.load_set_n),
+                   slip_setpoint=_none_if_nan(c.slip_setpoint),
+                   velocity_mps=float(c.velocity_set_mps), status=result.status,
                    flags=tuple(result.flags),
                    window_start_s=_none_if_nan(w.start_s) if w.found else None,
                    window_end_s=_none_if_nan(w.end_s) if w.found else None,

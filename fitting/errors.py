@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from swtlab_base.errors import InputError
 
-class FittingError(ValueError):
+
+class FittingError(InputError, ValueError):
     """Input a fit cannot honestly use; the message names the group, quantity and problem."""
 
 

@@ -6,10 +6,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+from swtlab_base.errors import InputError
+
 Severity = Literal["warning", "error"]
 
 
-class IngestError(Exception):
+class IngestError(InputError):
     """A run that cannot be used at all: ``"<path>: <channel>: <problem>"`` on one line."""
 
     def __init__(self, path: str | Path, channel: str | None, problem: str):

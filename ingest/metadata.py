@@ -10,10 +10,10 @@ import math
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Literal, Mapping, overload
 
 from ingest.errors import IngestError, Problem
-from swtlab_base.domain import G0_MPS2, MODES, Wheel
+from swtlab_base.domain import G0_MPS2, MODES, TestCondition, Wheel
 from swtlab_base.domain.ranges import METADATA
 
 #: longest text of a bad value an error message quotes
@@ -34,19 +34,15 @@ _CAMERA_KEYS = {"px_per_m", "travel_direction", "wheel_center_px", "wheel_radius
 
 @dataclass(frozen=True)
 class RunInfo:
-    """``swt.run``. ``load_n`` is the set wheel load (spec key ``load_N``)."""
+    """``swt.run``: which run, of which campaign, wheel and soil, and its set point
+    ``condition`` (the spec's ``load_N`` is its ``load_set_n``, ``velocity_mps`` its
+    ``velocity_set_mps``)."""
 
     run_id: str
     campaign: str
     wheel: str
     soil: str
-    multipass: int
-    mode: str
-    load_n: float
-    slip_setpoint: float | None
-    velocity_mps: float
-    gravity_mps2: float = G0_MPS2
-    steer_deg: float | None = None
+    condition: TestCondition
     started_at: datetime | None = None
     #: set wheel surface speed r*omega, for rigs that impose it instead of slip (channel map)
     wheel_surface_speed_setpoint_mps: float | None = None
@@ -96,12 +92,10 @@ class RunMetadata:
         """Plain JSON-ready dict (datetimes as ISO strings, calibration keys as 'topic.field')."""
         from dataclasses import asdict
 
-        out = {}
-        for name in ("run", "wheel", "suspension", "camera", "camera_track"):
+        out: dict[str, Any] = {"run": _run_record(self.run)}
+        for name in ("wheel", "suspension", "camera", "camera_track"):
             part = getattr(self, name)
             out[name] = None if part is None else asdict(part)
-        if out["run"]["started_at"] is not None:
-            out["run"]["started_at"] = self.run.started_at.isoformat()
         out["zero"] = dict(self.zero)
         out["calibration"] = {f"{t}.{f}": {"gain": g, "offset": o}
                               for (t, f), (g, o) in self.calibration.items()}
@@ -139,8 +133,22 @@ class _Reader:
         except (TypeError, ValueError, OverflowError):
             raise self.fail(key, f"{_shown(value)} is not {kind}") from None
 
+    @overload
+    def text(self, key: str, required: Literal[True] = True) -> str: ...
+    @overload
+    def text(self, key: str, required: Literal[False]) -> str | None: ...
+    @overload
+    def text(self, key: str, required: bool) -> str | None: ...
+
     def text(self, key: str, required: bool = True) -> str | None:
         return self._get(key, required, lambda v: str(v).strip(), "text")
+
+    @overload
+    def number(self, key: str, required: Literal[True] = True) -> float: ...
+    @overload
+    def number(self, key: str, required: Literal[False]) -> float | None: ...
+    @overload
+    def number(self, key: str, required: bool) -> float | None: ...
 
     def number(self, key: str, required: bool = True) -> float | None:
         value = self._get(key, required, float, "a number")
@@ -148,17 +156,43 @@ class _Reader:
             raise self.fail(key, f"{_shown(value)} is not a finite number")
         return value
 
+    @overload
+    def integer(self, key: str, required: Literal[True] = True) -> int: ...
+    @overload
+    def integer(self, key: str, required: Literal[False]) -> int | None: ...
+    @overload
+    def integer(self, key: str, required: bool) -> int | None: ...
+
     def integer(self, key: str, required: bool = True) -> int | None:
         value = self.number(key, required)
         if value is not None and value != int(value):
             raise self.fail(key, f"{value!r} is not a whole number")
         return None if value is None else int(value)
 
+    @overload
+    def positive(self, key: str, required: Literal[True] = True) -> float: ...
+    @overload
+    def positive(self, key: str, required: Literal[False]) -> float | None: ...
+    @overload
+    def positive(self, key: str, required: bool) -> float | None: ...
+
     def positive(self, key: str, required: bool = True) -> float | None:
         value = self.number(key, required)
         if value is not None and value <= 0:
             raise self.fail(key, f"{value:g} must be > 0")
         return value
+
+
+def _run_record(info: RunInfo) -> dict[str, Any]:
+    """``swt.run`` as a flat record with the spec's key names in lower case (``load_n``,
+    ``velocity_mps``), the start time as ISO text: what ``swtlab inspect --json`` shows."""
+    c = info.condition
+    return {"run_id": info.run_id, "campaign": info.campaign, "wheel": info.wheel,
+            "soil": info.soil, "multipass": c.multipass, "mode": c.mode, "load_n": c.load_set_n,
+            "slip_setpoint": c.slip_setpoint, "velocity_mps": c.velocity_set_mps,
+            "gravity_mps2": c.gravity_mps2, "steer_deg": c.steer_deg,
+            "started_at": None if info.started_at is None else info.started_at.isoformat(),
+            "wheel_surface_speed_setpoint_mps": info.wheel_surface_speed_setpoint_mps}
 
 
 def _unknown_keys(name: str, values: Mapping[str, Any], known: set[str]) -> list[Problem]:
@@ -201,11 +235,13 @@ def _run_info(path: Path, values: Mapping[str, Any], form: str) -> RunInfo:
         started_at = None if started is None else datetime.fromisoformat(started)
     except ValueError:
         raise r.fail("started_at", f"{started!r} is not an ISO 8601 date-time") from None
+    condition = TestCondition(mode=mode, load_set_n=load_n, multipass=multipass,
+                              velocity_set_mps=velocity, slip_setpoint=slip,
+                              gravity_mps2=G0_MPS2 if gravity is None else gravity,
+                              steer_deg=steer)
     return RunInfo(run_id=r.text("run_id"), campaign=r.text("campaign"), wheel=r.text("wheel"),
-                   soil=r.text("soil"), multipass=multipass, mode=mode, load_n=load_n,
-                   slip_setpoint=slip, velocity_mps=velocity,
-                   gravity_mps2=G0_MPS2 if gravity is None else gravity, steer_deg=steer,
-                   started_at=started_at, wheel_surface_speed_setpoint_mps=surface_speed)
+                   soil=r.text("soil"), condition=condition, started_at=started_at,
+                   wheel_surface_speed_setpoint_mps=surface_speed)
 
 
 def _slip_from_speeds(surface_speed_mps: float, velocity_mps: float) -> float | None:
@@ -233,12 +269,13 @@ def _camera_info(path: Path, values: Mapping[str, Any], form: str) -> CameraInfo
     direction = r.text("travel_direction", required=False) or "+x"
     if direction not in ("+x", "-x"):
         raise r.fail("travel_direction", f"{direction!r}: use +x or -x")
-    centre = r.text("wheel_center_px", required=False)
-    if centre is not None:
+    centre_text = r.text("wheel_center_px", required=False)
+    centre = None
+    if centre_text is not None:
         try:
-            cx, cy = (float(v) for v in centre.strip("[]() ").split(","))
+            cx, cy = (float(v) for v in centre_text.strip("[]() ").split(","))
         except ValueError:
-            raise r.fail("wheel_center_px", f"{centre!r} is not 'x,y'") from None
+            raise r.fail("wheel_center_px", f"{centre_text!r} is not 'x,y'") from None
         centre = (cx, cy)
     return CameraInfo(px_per_m=r.positive("px_per_m"), travel_direction=direction,
                       wheel_center_px=centre,

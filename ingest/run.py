@@ -313,8 +313,8 @@ def _derive_rates(table, streams, rate, metadata, provided, derivation) -> None:
         derivation["wheel_surface_speed_mps"] = {"method": "radius_m * wheel_omega_radps",
                                                  "radius_m": radius}
     if "wheel_surface_speed_mps" in table and "sled_velocity_mps" in table:
-        eps = derive.slip_eps(metadata.run.velocity_mps, table["wheel_surface_speed_mps"],
-                              table["sled_velocity_mps"])
+        eps = derive.slip_eps(metadata.run.condition.velocity_set_mps,
+                              table["wheel_surface_speed_mps"], table["sled_velocity_mps"])
         table["slip"] = derive.slip(table["wheel_surface_speed_mps"],
                                     table["sled_velocity_mps"], eps)
         derivation["slip"] = {"method": "spec: (r*omega - v)/(r*omega) driving, "

@@ -13,8 +13,8 @@ import pandas as pd
 
 from run_results.result import RunResult
 from swtlab_base.domain.replicates import with_repeatability
-from swtlab_base.domain.results import (COLUMNS, WHEEL_COLUMNS, budget_columns, check_results,
-                                   not_measured_text)
+from swtlab_base.domain.results import (COLUMNS, budget_columns, check_results,
+                                        not_measured_text, wheel_columns)
 
 
 GROUP = ["wheel", "soil", "multipass", "load_set_n"]
@@ -23,11 +23,10 @@ GROUP = ["wheel", "soil", "multipass", "load_set_n"]
 def results_row(r: RunResult) -> dict:
     """One run's row of the results table (``swtlab_base.domain.results``, docs/results.md)."""
     c, w = r.condition, r.window
-    row = {"campaign": c["campaign"], "run_id": r.run_id,
-           **{k: c[k] for k in ("wheel", *WHEEL_COLUMNS, "soil")},
-           "mode": r.mode, "multipass": c["multipass"], "load_set_n": c["load_n"],
-           "slip_setpoint": c["slip_setpoint"], "velocity_set_mps": c["velocity_mps"],
-           "gravity_mps2": c["gravity_mps2"], "steer_deg": c["steer_deg"], "status": r.status,
+    row = {"campaign": r.campaign, "run_id": r.run_id, **wheel_columns(r.wheel), "soil": r.soil,
+           "mode": c.mode, "multipass": c.multipass, "load_set_n": c.load_set_n,
+           "slip_setpoint": c.slip_setpoint, "velocity_set_mps": c.velocity_set_mps,
+           "gravity_mps2": c.gravity_mps2, "steer_deg": c.steer_deg, "status": r.status,
            "flags": "; ".join(r.flags), "window_found": w.found, "window_start_s": w.start_s,
            "window_end_s": w.end_s, "window_method": w.method, "no_window_reason": w.reason,
            "not_measured": not_measured_text(m for b in r.uncertainty.values()

@@ -93,7 +93,7 @@ def native_quantities(run, start_s: float, end_s: float, units: dict[str, str],
         result = native_stats(*hub, frequency_hz, units["hub_height_m"])
         if result is not None:
             load = (stats["wheel_load_n"].mean if "wheel_load_n" in stats
-                    else run.metadata.run.load_n)
+                    else run.metadata.run.condition.load_set_n)
             shift = 0.0 if rig is None else float(rig.correction(load))
             stats["hub_height_m"] = replace(result, mean=result.mean + shift)
     means = {}

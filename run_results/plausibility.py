@@ -103,7 +103,7 @@ def spike_flags(run, start_s: float, end_s: float) -> list[str]:
     :data:`SPIKE_LOAD_RATIO` times the set load (times the radius for a torque): an electrical
     glitch, not the soil (a stone under the wheel loads it by a fraction of its load); and hub
     heights (from the arm angle) that jump by more than the wheel radius."""
-    load, radius = run.metadata.run.load_n, run.metadata.wheel.radius_m
+    load, radius = run.metadata.run.condition.load_set_n, run.metadata.wheel.radius_m
     flags = []
     for column, y in _window_samples(run, start_s, end_s):
         scale = SPIKE_LOAD_RATIO * load * (radius if column.endswith("_nm") else 1.0)
@@ -150,7 +150,7 @@ def _beyond_noise(q, floor: float) -> bool:
 def load_flags(run, quantities: dict) -> list[str]:
     """Negative load or sinkage beyond the noise; measured against set load."""
     flags = []
-    load_set = run.metadata.run.load_n
+    load_set = run.metadata.run.condition.load_set_n
     load = quantities.get("wheel_load_n")
     if load is not None and np.isfinite(load.mean):
         if _beyond_noise(load, 0.0):
@@ -206,8 +206,8 @@ def set_point_flags(window) -> list[str]:
 def metadata_flags(metadata) -> list[str]:
     """Wheel geometry, set load and gravity outside their plausible ranges."""
     values = {key: getattr(metadata.wheel, field) for key, field in WHEEL_KEYS.items()}
-    values.update({"run.load_N": metadata.run.load_n,
-                   "run.gravity_mps2": metadata.run.gravity_mps2})
+    values.update({"run.load_N": metadata.run.condition.load_set_n,
+                   "run.gravity_mps2": metadata.run.condition.gravity_mps2})
     flags = []
     for key, value in values.items():
         why = None if value is None else METADATA[key].implausible(float(value))
@@ -226,7 +226,7 @@ def dig_in_flags(run, window, params) -> list[str]:
     its peak and ``params.dig_in_dp_drop_ratio`` of the set load), or sinkage that grew
     significantly through the first candidate window when only its flat second half was kept
     (stable-phase slope test)."""
-    ch, load = run.channels, run.metadata.run.load_n
+    ch, load = run.channels, run.metadata.run.condition.load_set_n
     t = ch["t_s"].to_numpy()
     gate_s = window.diagnostics.get("gate_start_s")
     lo, start, stop = (int(np.searchsorted(t, x)) for x in (gate_s, window.start_s,
@@ -237,7 +237,7 @@ def dig_in_flags(run, window, params) -> list[str]:
     dt = float(median(np.diff(t)))
     width = max(int(round(max(period or 0.0, params.batch_s) / dt)), 1)
     dp = ch["dp_n"].to_numpy()
-    if run.metadata.run.mode != "free_sled" and start - lo > width \
+    if run.metadata.run.condition.mode != "free_sled" and start - lo > width \
             and np.isfinite(dp[lo:stop]).mean() > 0.5:
         smooth = moving_average(dp[lo:stop], width, full_only=True)
         before, inside = smooth[:start - lo], dp[start:stop]

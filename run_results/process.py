@@ -37,7 +37,6 @@ from run_results.traces import run_traces
 from run_results.uncertainty_budget import BudgetParams, run_budget
 from stable_phase import StablePhaseParams, detect_stable_phase
 from stable_phase.signals import decimate_mean
-from swtlab_base.domain.results import wheel_columns
 from swtlab_base.order_stats import median
 
 #: quantities from the window's displacements (``run_results.rates``)
@@ -48,20 +47,12 @@ GROUSER_MISMATCH_RATIO = 0.05
 DP_TRACE_POINTS = 500
 
 
-def _condition(run) -> dict:
-    info = run.metadata.run
-    return {"campaign": info.campaign, **wheel_columns(run.metadata.wheel), "soil": info.soil,
-            "multipass": info.multipass, "load_n": info.load_n,
-            "slip_setpoint": info.slip_setpoint, "velocity_mps": info.velocity_mps,
-            "steer_deg": info.steer_deg, "gravity_mps2": info.gravity_mps2}
-
-
 def _series(run, rig: RigCompliance | None) -> tuple[dict[str, tuple[np.ndarray, str]], dict]:
     """Every quantity's per-sample series (after corrections) with its unit."""
     ch, meta = run.channels, run.metadata
     radius = meta.wheel.radius_m
     fz = ch["fz_n"].to_numpy()
-    fz_for_rig = np.where(np.isfinite(fz), fz, meta.run.load_n)
+    fz_for_rig = np.where(np.isfinite(fz), fz, meta.run.condition.load_set_n)
     hub, sinkage, correction = corrected_heights(ch["hub_height_m"].to_numpy(), fz_for_rig,
                                                  meta.wheel.stiffness_n_per_mm, rig)
     if rig is None:
@@ -80,12 +71,13 @@ def _series(run, rig: RigCompliance | None) -> tuple[dict[str, tuple[np.ndarray,
         "sinkage_m": (sinkage, "m"),
         "hub_height_m": (hub, "m"),
     }
-    if meta.run.mode == "steered":
+    if meta.run.condition.mode == "steered":
         series["side_force_n"] = (ch["fy_n"].to_numpy(), "N")
         if "slip_angle_rad" in ch and np.isfinite(ch["slip_angle_rad"].to_numpy()).any():
             series["slip_angle_deg"] = (np.degrees(ch["slip_angle_rad"].to_numpy()), "deg")
         else:
-            series["slip_angle_deg"] = (np.full(len(ch), float(meta.run.steer_deg)), "deg")
+            steer_deg = float(meta.run.condition.steer_deg)
+            series["slip_angle_deg"] = (np.full(len(ch), steer_deg), "deg")
     return series, {"correction_m": correction}
 
 
@@ -98,7 +90,7 @@ def _oscillation(run, t, lo, hi, series) -> tuple[dict, float | None]:
            "grouser_measured_hz": None, "grouser_signal": None}
     candidates = [k for k in ("dp_n", "torque_nm", "wheel_load_n")
                   if np.isfinite(series[k][0][lo:hi]).mean() > 0.5
-                  and not (k == "dp_n" and run.metadata.run.mode == "free_sled")]
+                  and not (k == "dp_n" and run.metadata.run.condition.mode == "free_sled")]
     if out["grouser_expected_hz"] and candidates:
         signal = candidates[0]
         out["grouser_signal"] = signal
@@ -201,8 +193,10 @@ def process_run(run, params: StablePhaseParams | None = None,
     t = run.channels["t_s"].to_numpy()
     corrections = {"tare": tare_record(run),
                    "rig_compliance": None if rig is None else rig.to_dict()}
-    common = {"run_id": run.run_id, "mode": run.metadata.run.mode, "window": window,
-              "condition": _condition(run), "traces": run_traces(t, series)}
+    info = run.metadata.run
+    common = {"run_id": run.run_id, "window": window, "campaign": info.campaign,
+              "wheel": run.metadata.wheel, "soil": info.soil, "condition": info.condition,
+              "traces": run_traces(t, series)}
     if not window.found:
         tb, dpb = decimate_mean(t, run.channels["dp_n"].to_numpy(), DP_TRACE_POINTS)
         trace = {"t_s": tb.tolist(), "dp_n": [None if not np.isfinite(v) else float(v)

@@ -509,13 +509,13 @@ def with_diffusion(budgets: dict[str, QuantityBudget],
 
 def pool_drift(results: list) -> list:
     """``run_results.RunResult`` s with the drift diffusion pooled over the rest readings of
-    the runs of each campaign (``condition["campaign"]``, one rig's cells;
+    the runs of each campaign (``RunResult.campaign``, one rig's cells;
     :func:`pooled_diffusion`); the means are unchanged."""
     campaigns: dict = {}
     for r in results:
-        campaigns.setdefault(r.condition.get("campaign"), []).append(
+        campaigns.setdefault(r.campaign, []).append(
             r.corrections.get("rest_readings"))
     diffusion = {c: pooled_diffusion(records) for c, records in campaigns.items()}
     return [replace(r, uncertainty=with_diffusion(r.uncertainty,
-                                                  diffusion[r.condition.get("campaign")]))
+                                                  diffusion[r.campaign]))
             for r in results]

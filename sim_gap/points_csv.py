@@ -16,6 +16,7 @@ import pandas as pd
 
 from sim_gap.vocabulary import QUANTITIES
 from swtlab_base.domain import G0_MPS2, Wheel
+from swtlab_base.errors import InputError
 
 #: columns every points CSV has
 REQUIRED = ("source", "wheel_radius_m", "wheel_width_m", "load_set_n", "slip")
@@ -29,7 +30,7 @@ QUANTITY_COLUMNS = tuple(c for q in QUANTITIES for c in (q, f"{q}_se", f"{q}_sd"
 WHEEL_KEY = ("wheel_radius_m", "wheel_width_m", "grouser_count", "grouser_height_m")
 
 
-class PointsFormatError(ValueError):
+class PointsFormatError(InputError, ValueError):
     """A points CSV problem: ``file:line: column: problem`` on one line."""
 
 

@@ -6,9 +6,10 @@ from __future__ import annotations
 import pandas as pd
 
 from sim_gap.simulated import Simulated
+from swtlab_base.errors import InputError
 
 
-class WheelMismatchError(ValueError):
+class WheelMismatchError(InputError, ValueError):
     """The measured and the simulated wheel differ; the message says how."""
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from softflow.decay_fit import DecayFit
+from swtlab_base.errors import InputError
 
 MIN_RIM_FRACTION = 0.3
 MIN_R2 = 0.5
@@ -34,7 +35,7 @@ EPS_RESOLUTION = 0.01
 CONTACT_BETA_DEG = (-160.0, -20.0)
 
 
-class FlowMeasurementError(ValueError):
+class FlowMeasurementError(InputError, ValueError):
     """The frames were read but the soil flow could not be measured from them."""
 
 

@@ -17,13 +17,14 @@ import numpy as np
 
 from softflow.field_analysis import FlowResult, analyse_frames
 from softflow.frames import _decode, load_frames
+from swtlab_base.errors import InputError
 
 SIDE_TOPIC = "/camera/side"
 #: most frames analysed per run (memory: one velocity field per pair is kept)
 MAX_FRAMES = 32
 
 
-class FlowRunError(ValueError):
+class FlowRunError(InputError, ValueError):
     """Side-camera frames of a run that cannot be analysed: where, which channel, the problem."""
 
     def __init__(self, source, problem: str) -> None:

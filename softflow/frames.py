@@ -20,11 +20,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from swtlab_base.errors import InputError
+
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mkv")
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
 
 
-class FrameSourceError(ValueError):
+class FrameSourceError(InputError, ValueError):
     """The frames or their scale could not be read."""
 
 

@@ -19,6 +19,7 @@ import cv2
 import numpy as np
 
 from softflow import track_period, track_profile
+from swtlab_base.errors import InputError
 
 MIN_MARKS = 5  # marks needed for a spacing
 MIN_FOUND_FRACTION = 0.5  # of the one-period windows along the visible track
@@ -27,7 +28,7 @@ MIN_COHERENCE = 0.85  # |sum of row amplitudes| / sum of |row amplitudes| across
 MAX_RESIDUAL = 0.12  # RMS of mark positions about the line, fraction of the spacing
 
 
-class NoPeriodicMarksError(ValueError):
+class NoPeriodicMarksError(InputError, ValueError):
     """The image shows no significant periodic grouser marks: no slip is given."""
 
     def __init__(self, detail: str = ""):

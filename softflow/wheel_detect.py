@@ -26,6 +26,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from swtlab_base.errors import InputError
+
 N_RAYS = 720
 MASK_MARGIN_PX = 8.0  # soil kept this far from the grouser tips (texture window, blur)
 
@@ -42,7 +44,7 @@ class WheelPose:
     soil_angles_rad: np.ndarray | None = None  # image angles of the rays facing the soil
 
 
-class WheelNotFoundError(ValueError):
+class WheelNotFoundError(InputError, ValueError):
     """No wheel-like smooth region in the frame."""
 
 

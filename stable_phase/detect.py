@@ -37,7 +37,8 @@ MIN_SAMPLES = 16
 
 def _signals(run, lo: int, hi: int) -> dict[str, np.ndarray]:
     ch = run.channels
-    names = [c for c in SETTLING if not (c == "dp_n" and run.metadata.run.mode == "free_sled")]
+    free_sled = run.metadata.run.condition.mode == "free_sled"
+    names = [c for c in SETTLING if not (c == "dp_n" and free_sled)]
     out = {}
     for name in names:
         y = ch[name].to_numpy()[lo:hi]
@@ -48,7 +49,7 @@ def _signals(run, lo: int, hi: int) -> dict[str, np.ndarray]:
 
 def _limits(run, signals: dict[str, np.ndarray], params: StablePhaseParams) -> dict[str, float]:
     """Practical drift limits over a window: a share of the load (forces) or of the sinkage."""
-    load_n = run.metadata.run.load_n
+    load_n = run.metadata.run.condition.load_set_n
     limits = {"dp_n": params.slope_change_force_ratio * load_n,
               "ty_nm": params.slope_change_force_ratio * load_n * run.metadata.wheel.radius_m}
     if "sinkage_m" in signals:
@@ -100,11 +101,12 @@ def _no_stable_reason(run, t: np.ndarray, lo: int, hi: int, period_s: float | No
         if z[last] - z[mid] > params.slope_change_sinkage_ratio * abs(z[last]):
             parts.append(f"sinkage grows from {1e3 * z[finite[0]]:.1f} to {1e3 * z[last]:.1f} mm")
     dp = ch["dp_n"].to_numpy()[lo:hi]
-    if parts and run.metadata.run.mode != "free_sled" and np.isfinite(dp).mean() > 0.5:
+    if parts and run.metadata.run.condition.mode != "free_sled" and np.isfinite(dp).mean() > 0.5:
         dp = moving_average(dp, width, full_only=True)
         peak = int(np.nanargmax(dp))
         end = float(dp[np.flatnonzero(np.isfinite(dp))[-1]])
-        if float(dp[peak]) - end > params.dig_in_dp_drop_ratio * run.metadata.run.load_n:
+        load_n = run.metadata.run.condition.load_set_n
+        if float(dp[peak]) - end > params.dig_in_dp_drop_ratio * load_n:
             parts.insert(0, f"drawbar pull rises to {dp[peak]:.1f} N at {t[lo + peak]:.1f} s, "
                             f"then collapses to {end:.1f} N")
             return "; ".join(parts) + ": wheel digs in, no stable phase"

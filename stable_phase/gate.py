@@ -65,17 +65,18 @@ def references(run, surface_mps: np.ndarray, velocity_mps: np.ndarray,
                rel_tol: float) -> dict[str, float]:
     """Reference speeds (m/s) the gate holds the run to, by test mode."""
     info = run.metadata.run
-    if info.mode == "free_sled":
+    c = info.condition
+    if c.mode == "free_sled":
         return {"wheel_surface_speed_mps": _plateau(surface_mps, rel_tol),
                 "sled_velocity_mps": _plateau(velocity_mps, rel_tol)}
-    if info.mode == "towed" or (info.slip_setpoint is None
+    if c.mode == "towed" or (c.slip_setpoint is None
                                 and info.wheel_surface_speed_setpoint_mps is None):
         return {"wheel_surface_speed_mps": _plateau(surface_mps, rel_tol),
-                "sled_velocity_mps": info.velocity_mps}
+                "sled_velocity_mps": c.velocity_set_mps}
     surface = info.wheel_surface_speed_setpoint_mps
     if surface is None:
-        surface = surface_speed_setpoint_mps(info.velocity_mps, info.slip_setpoint)
-    return {"wheel_surface_speed_mps": surface, "sled_velocity_mps": info.velocity_mps}
+        surface = surface_speed_setpoint_mps(c.velocity_set_mps, c.slip_setpoint)
+    return {"wheel_surface_speed_mps": surface, "sled_velocity_mps": c.velocity_set_mps}
 
 
 def speed_gate(run, params: StablePhaseParams) -> Gate:

@@ -47,8 +47,9 @@ def atomic_file(path: str | Path, mode: str = "w", *, encoding: str | None = "ut
         umask = os.umask(0)
         os.umask(umask)
         os.fchmod(handle, 0o666 & ~umask)
-        text = {"encoding": encoding, "newline": newline} if mode == "w" else {}
-        with os.fdopen(handle, mode, **text) as stream:
+        stream: IO = (os.fdopen(handle, "w", encoding=encoding, newline=newline) if mode == "w"
+                      else os.fdopen(handle, "wb"))
+        with stream:
             yield stream
             stream.flush()
             os.fsync(stream.fileno())

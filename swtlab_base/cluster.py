@@ -13,13 +13,17 @@ a thread per core.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 #: how long :func:`connect` waits for its scheduler
 CONNECT_TIMEOUT_S = 20
 
 
-def connect(address: str):
+def connect(address: str) -> Client:
     """A ``dask.distributed.Client`` of the scheduler at ``address``; a one-line
     ``ValueError`` when dask is not installed or the scheduler cannot be reached."""
     try:
@@ -33,7 +37,7 @@ def connect(address: str):
         raise ValueError(f"--dask {address}: cannot reach the scheduler ({error})") from None
 
 
-def task_slots(client) -> dict[str, int]:
+def task_slots(client: Client) -> dict[str, int]:
     """Task threads (``nthreads``) of the client's workers, summed per host."""
     slots: dict[str, int] = {}
     for worker in client.scheduler_info()["workers"].values():
@@ -53,12 +57,14 @@ def worker_threads(slots: dict[str, int]) -> int:
     return max(1, available_cores() // max(1, slots.get(worker.ip, worker.state.nthreads)))
 
 
-def _capped(fn, limit: Callable[[int], None], slots: dict[str, int], *args):
+def _capped(fn: Callable[..., Any], limit: Callable[[int], None], slots: dict[str, int],
+            *args: Any) -> Any:
     limit(worker_threads(slots))
     return fn(*args)
 
 
-def map_in_order(client, fn, *iterables, limit: Callable[[int], None]) -> Iterator:
+def map_in_order(client: Client, fn: Callable[..., Any], *iterables: Iterable[Any],
+                 limit: Callable[[int], None]) -> Iterator[Any]:
     """``fn(*args)`` for each ``args`` of ``zip(*iterables)``, on the workers of ``client``
     (each task first calls ``limit(threads)`` with its share of its host's cores), yielded
     in input order as they are done; an error raised by ``fn`` is raised here. Arguments

@@ -52,7 +52,7 @@ def value_and_u(value: float | None, u: float | None, scale: float = 1.0
     as given ('' when None or NaN)."""
     if value is not None and math.isfinite(value):
         value = value * scale
-    if not _usable(u):
+    if u is None or not _usable(u):
         return plain(value), "" if u is None or not math.isfinite(u) else plain(u * scale)
     u = u * scale
     places = decimals(u)

@@ -2,7 +2,7 @@
 
 OK = 0  # the command did its job (a batch may still report runs it could not use)
 USAGE = 2  # bad command line (argparse's own code)
-BAD_INPUT = 3  # the input could not be used at all: unreadable file, nothing processed
+BAD_INPUT = 3  # an InputError: the input could not be used at all, nothing processed
 INTERNAL = 4  # an unexpected error inside swtlab outside any run: please report it
 
 EPILOG = """exit codes:

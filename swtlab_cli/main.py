@@ -12,6 +12,7 @@ import argparse
 import importlib
 import sys
 
+from swtlab_base.errors import InputError
 from swtlab_cli import exit_codes
 
 #: command -> its one-line help (the same as the module's ``add_parser(help=...)``; a test
@@ -74,13 +75,6 @@ def _command(argv: list[str]) -> str | None:
     return word if word in COMMANDS else None
 
 
-def _is_database_error(exc: Exception) -> bool:
-    """A database that cannot be used as asked (``traceability.database.UnusableDatabase``): the
-    user's input, not swtlab's fault. Checked without importing the database layer."""
-    database = sys.modules.get("traceability.database")
-    return database is not None and isinstance(exc, database.UnusableDatabase)
-
-
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command(argv))
@@ -93,10 +87,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("swtlab: interrupted", file=sys.stderr)
         return 130
+    except InputError as exc:  # the user's file, value or database: one line naming it
+        print(f"swtlab {args.command}: {exc}", file=sys.stderr)
+        return exit_codes.BAD_INPUT
     except Exception as exc:  # last line of defence, one line for the user
-        if _is_database_error(exc):
-            print(f"swtlab {args.command}: {exc}", file=sys.stderr)
-            return exit_codes.BAD_INPUT
         print(f"swtlab: internal error: {type(exc).__name__}: {exc} "
               "(rerun with SWTLAB_DEBUG=1 for the traceback)", file=sys.stderr)
         import os

@@ -7,6 +7,7 @@ import tomllib
 from pathlib import Path
 
 from swtlab_base.atomic import write_atomically
+from swtlab_base.errors import InputError
 from terramechanics.effects import EFFECTS, make_effect
 from terramechanics.model import WheelModel
 from terramechanics.soil import SOILS, SoilParams
@@ -16,7 +17,7 @@ from terramechanics.wheel import Wheel
 SHIPPED_MODELS = Path(__file__).parent / "models"
 
 
-class ModelFileError(ValueError):
+class ModelFileError(InputError, ValueError):
     """A model file that cannot be used; the message names the table and key."""
 
 

@@ -34,7 +34,8 @@ def test_the_nonsense_judge_catches_an_impossible_result():
     from run_results.stats import QuantityStats
 
     def result(**quantities):
-        return SimpleNamespace(condition={"wheel_radius_m": 0.125, "load_n": 180.0},
+        return SimpleNamespace(wheel=SimpleNamespace(radius_m=0.125),
+                               condition=SimpleNamespace(load_set_n=180.0),
                                quantities={k: QuantityStats(*v, n=100, n_eff=50.0, unit="")
                                            for k, v in quantities.items()})
 

@@ -217,7 +217,8 @@ def test_headerless_delimited_file_with_column_order(tmp_path):
     np.testing.assert_allclose(ch.loc[inner, "sled_velocity_mps"], 0.04, rtol=1e-6)
     np.testing.assert_allclose(ch["fz_n"], 22.0 * 4.4482216152605, rtol=1e-9)
     np.testing.assert_allclose(ch["hub_height_m"], 0.005 - 0.002 * ch["t_s"], atol=1e-9)
-    assert run.metadata.run.multipass == 2 and run.metadata.run.load_n == 95.0
+    condition = run.metadata.run.condition
+    assert condition.multipass == 2 and condition.load_set_n == 95.0
     assert run.metadata.run.run_id == "run_2_95N"
     assert ingest.find_runs(tmp_path, map_path) == [path]
 

@@ -49,8 +49,9 @@ def test_slip_and_hub_height_on_the_common_time_base(cmu_campaign):
     assert ch["slip"].notna().mean() > 0.95 and ch["hub_height_m"].notna().all()
     assert run.channels["hub_height_m"].iloc[0] == pytest.approx(0.0315)  # authors' zeroing
     meta = run.metadata
-    assert meta.run.mode == "speed_control" and meta.run.slip_setpoint == pytest.approx(0.5)
-    assert meta.run.velocity_mps == pytest.approx(0.010)
+    assert meta.run.condition.mode == "speed_control"
+    assert meta.run.condition.slip_setpoint == pytest.approx(0.5)
+    assert meta.run.condition.velocity_set_mps == pytest.approx(0.010)
     assert meta.wheel.radius_m == 0.058 and meta.wheel.grouser_count == 0
     assert run.derivation["slip"]["method"].startswith("spec")
 
@@ -80,8 +81,9 @@ def test_file_name_gives_steering_and_slip_set_point(tmp_path, ingest_cmu_root):
     target.write_bytes(source.read_bytes())
     run = ingest.read_run(target, "cmu_3d_terramechanics")
     assert run.run_id == "gr630_vx_10/11-19-20/10_40_30_1"
-    assert run.metadata.run.mode == "steered" and run.metadata.run.steer_deg == 30.0
-    assert run.metadata.run.slip_setpoint == pytest.approx(0.75)
+    condition = run.metadata.run.condition
+    assert condition.mode == "steered" and condition.steer_deg == 30.0
+    assert run.metadata.run.condition.slip_setpoint == pytest.approx(0.75)
     assert run.metadata.run.wheel_surface_speed_setpoint_mps == pytest.approx(0.040)
 
 

@@ -66,5 +66,6 @@ def test_csv_empty_records_and_json_nulls_count_as_absent(tmp_path, ingest_tools
     meta["run"]["steer_deg"] = None
     (folder / "run.json").write_text(json.dumps(meta))
     run = ingest.read_run(folder)
-    assert run.metadata.run.mode == "towed" and run.metadata.run.slip_setpoint is None
+    condition = run.metadata.run.condition
+    assert condition.mode == "towed" and condition.slip_setpoint is None
     assert run.metadata.camera is None

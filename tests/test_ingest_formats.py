@@ -189,7 +189,7 @@ def test_hdf5_root_attributes_and_sidecar_give_the_records(tmp_path, spec_run):
     fw.write_sidecar(fw.SpecRun({}, {"run": {"load_N": "99.5"},
                                      "calibration": spec_run.records["calibration"]}), path)
     meta = ingest.read_run(path).metadata
-    assert meta.wheel.radius_m == 0.2 and meta.run.load_n == 99.5
+    assert meta.wheel.radius_m == 0.2 and meta.run.condition.load_set_n == 99.5
     assert meta.run.run_id == spec_run.records["run"]["run_id"]
 
 
@@ -233,6 +233,7 @@ def test_same_stem_runs_need_their_own_sidecars(tmp_path, spec_run, reference):
     (tmp_path / "run7.run.json").rename(tmp_path / "run7.bag.run.json")
     records = {**spec_run.records, "run": {**spec_run.records["run"], "load_N": "99.5"}}
     (tmp_path / "run7.h5.run.json").write_text(json.dumps(records), encoding="utf-8")
-    assert ingest.read_run(h5).metadata.run.load_n == 99.5
-    assert ingest.read_run(bag, "spec_ros").metadata.run.load_n == reference.metadata.run.load_n
-    assert reference.metadata.run.load_n != 99.5
+    assert ingest.read_run(h5).metadata.run.condition.load_set_n == 99.5
+    assert ingest.read_run(bag, "spec_ros").metadata.run.condition.load_set_n \
+        == reference.metadata.run.condition.load_set_n
+    assert reference.metadata.run.condition.load_set_n != 99.5

@@ -28,10 +28,10 @@ def test_streams_carry_true_si_values_on_native_time_stamps(ingest_good_mcap, in
 
 def test_metadata_is_typed(ingest_good_mcap):
     meta = ingest.read_run(ingest_good_mcap).metadata
-    assert meta.run.run_id == "r001" and meta.run.mode == "speed_control"
-    assert meta.run.multipass == 0 and isinstance(meta.run.multipass, int)
-    assert meta.run.load_n == 150.0 and meta.run.slip_setpoint == 0.25
-    assert meta.run.gravity_mps2 == 9.80665 and meta.run.steer_deg is None
+    assert meta.run.run_id == "r001" and meta.run.condition.mode == "speed_control"
+    assert meta.run.condition.multipass == 0 and isinstance(meta.run.condition.multipass, int)
+    assert meta.run.condition.load_set_n == 150.0 and meta.run.condition.slip_setpoint == 0.25
+    assert meta.run.condition.gravity_mps2 == 9.80665 and meta.run.condition.steer_deg is None
     assert meta.run.started_at == datetime(2026, 11, 20, 10, tzinfo=timezone.utc)
     assert meta.wheel.radius_m == 0.1 and meta.wheel.grouser_count == 12
     assert meta.wheel.stiffness_n_per_mm is None
@@ -42,7 +42,7 @@ def test_metadata_is_typed(ingest_good_mcap):
 def test_gravity_defaults_when_absent(tmp_path, ingest_tools, ingest_spec):
     ingest_spec.records = ingest_tools.records(run={"gravity_mps2": None, "started_at": None})
     meta = ingest.read_run(ingest_tools.write_mcap(tmp_path / "g.mcap", ingest_spec)).metadata
-    assert meta.run.gravity_mps2 == 9.80665 and meta.run.started_at is None
+    assert meta.run.condition.gravity_mps2 == 9.80665 and meta.run.started_at is None
 
 
 def test_calibration_then_zero_offsets(tmp_path, ingest_tools, ingest_spec):

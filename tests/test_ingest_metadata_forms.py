@@ -110,12 +110,13 @@ def test_sidecar_for_a_delimited_text_log(tmp_path, ingest_cmu_root):
     source = ingest_cmu_root / "raw" / "gr810_vx_10" / "12-5-20" / "10_3_0_1.txt"
     log = Path(shutil.copy(source, tmp_path / source.name))
     default = ingest.read_run(log, CMU_MAP).metadata
-    assert (default.run.load_n, default.wheel.radius_m) == (23.0, 0.058)
+    assert (default.run.condition.load_set_n, default.wheel.radius_m) == (23.0, 0.058)
     (tmp_path / "10_3_0_1.run.json").write_text(json.dumps(
         {"run": {"load_N": 25.5, "velocity_mps": 0.5}, "wheel": {"radius_m": 0.06}}))
     meta = ingest.read_run(log, CMU_MAP).metadata
-    assert (meta.run.load_n, meta.wheel.radius_m) == (25.5, 0.06)
-    assert meta.run.velocity_mps == default.run.velocity_mps  # the file name's, not 0.5
+    assert (meta.run.condition.load_set_n, meta.wheel.radius_m) == (25.5, 0.06)
+    # the file name's, not 0.5
+    assert meta.run.condition.velocity_set_mps == default.run.condition.velocity_set_mps
     assert ingest.find_runs(tmp_path, CMU_MAP) == [log]
 
 

@@ -51,7 +51,7 @@ def walked(tmp_path_factory):
 
 def test_every_block_runs_and_writes_its_files(walked):
     namespace, out, work, n_blocks = walked
-    assert n_blocks == PAGE.read_text().count("```python") == 8
+    assert n_blocks == PAGE.read_text().count("```python") == 9
     for name in ("dp_vs_slip.png", "wpm.csv", "gap.json", "gap.html", "swtlab.sqlite",
                  "report.html"):
         assert (work / name).stat().st_size > 0, name

@@ -167,7 +167,7 @@ def test_status_flags_tare_and_json(processed):
     for truth, _run, result in processed:
         assert result.corrections["tare"]["zero_offsets_subtracted"] == truth["measurement"]["zero"]
         assert result.corrections["rig_compliance"] is None
-        assert result.condition["load_n"] == truth["condition"]["load_n"]
+        assert result.condition.load_set_n == truth["condition"]["load_n"]
         json.dumps(result.to_dict(), allow_nan=False)
         if result.status != "no_stable_phase":
             assert result.status == ("flagged" if result.flags else "ok")
@@ -235,4 +235,4 @@ def test_steered_run_reports_side_force_and_slip_angle(tmp_path):
     assert side.mean == pytest.approx(means["side_force_n"], abs=max(3 * side.se, 0.01 * 180.0))
     assert result.quantities["slip_angle_deg"].mean == means["slip_angle_deg"] == 10.0
     assert result.quantities["slip"].mean == pytest.approx(0.2, abs=0.005)
-    assert result.condition["steer_deg"] == 10.0
+    assert result.condition.steer_deg == 10.0

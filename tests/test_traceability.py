@@ -80,9 +80,9 @@ def test_conditions_and_calibrations_are_recorded(db_url):
     _store(factory, path)
     with factory() as session:
         condition = session.scalars(select(TestCondition)).one()
-        assert condition.load_n == run.metadata.run.load_n
-        assert condition.mode == run.metadata.run.mode
-        assert condition.multipass == run.metadata.run.multipass
+        assert condition.load_n == run.metadata.run.condition.load_set_n
+        assert condition.mode == run.metadata.run.condition.mode
+        assert condition.multipass == run.metadata.run.condition.multipass
         assert condition.wheel.radius_m == run.metadata.wheel.radius_m
         raw = session.scalars(select(RawFile)).one()
         zeros = {c.field: -c.offset for c in raw.calibrations if c.kind == "zero"}

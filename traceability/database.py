@@ -27,6 +27,8 @@ from sqlalchemy.engine import URL, make_url
 from sqlalchemy.exc import ArgumentError, DBAPIError, IntegrityError, OperationalError
 from sqlalchemy.orm import Session, sessionmaker
 
+from swtlab_base.errors import InputError
+
 MIGRATIONS = Path(__file__).parent / "migrations"
 #: the PostgreSQL advisory-lock key every swtlab writer takes (``pg_advisory_xact_lock``)
 WRITE_LOCK_KEY = 0x5717AB
@@ -39,7 +41,7 @@ UPGRADE_COMMAND = "swtlab migrate --db URL"
 T = TypeVar("T")
 
 
-class UnusableDatabase(Exception):
+class UnusableDatabase(InputError):
     """A database that cannot be used as asked: missing, unreachable, refused, wrong schema."""
 
 

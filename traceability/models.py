@@ -12,6 +12,8 @@ from sqlalchemy import (JSON, DateTime, Float, ForeignKey, Integer, LargeBinary,
                         UniqueConstraint)
 from sqlalchemy.orm import DeclarativeBase, Mapped, mapped_column, relationship
 
+from swtlab_base import domain
+
 #: characters of a name users write (campaign, run_id, wheel, soil, topic, channel field);
 #: longer names are refused by ``traceability.text`` with a clear error, on every backend
 NAME_CHARS = 1000
@@ -67,7 +69,9 @@ class Soil(Base):
 
 
 class TestCondition(Base):
-    """The set point of a run: mode, load, slip, velocity, soil pass, gravity, steer."""
+    """The set point of a run (:class:`swtlab_base.domain.TestCondition`, the one definition;
+    :meth:`to_domain` and :func:`condition_columns` map between the two) of one campaign, wheel
+    and soil. The columns keep the spec's names ``load_n`` and ``velocity_mps``."""
 
     __tablename__ = "test_condition"
     __test__ = False  # not a pytest class
@@ -85,6 +89,21 @@ class TestCondition(Base):
 
     wheel: Mapped[Wheel] = relationship()
     soil: Mapped[Soil] = relationship()
+
+    def to_domain(self) -> domain.TestCondition:
+        """This row's set point as the domain type."""
+        return domain.TestCondition(mode=self.mode, load_set_n=self.load_n,
+                                    multipass=self.multipass, velocity_set_mps=self.velocity_mps,
+                                    slip_setpoint=self.slip_setpoint,
+                                    gravity_mps2=self.gravity_mps2, steer_deg=self.steer_deg)
+
+
+def condition_columns(condition: domain.TestCondition) -> dict[str, object]:
+    """The :class:`TestCondition` row's set-point columns of ``condition``."""
+    return {"mode": condition.mode, "multipass": condition.multipass,
+            "load_n": condition.load_set_n, "slip_setpoint": condition.slip_setpoint,
+            "velocity_mps": condition.velocity_set_mps, "gravity_mps2": condition.gravity_mps2,
+            "steer_deg": condition.steer_deg}
 
 
 class Run(Base):

@@ -52,15 +52,15 @@ def latest_results(session: Session) -> pd.DataFrame:
         missing.setdefault(b.run_result_id, []).extend(b.not_measured or [])
     records = []
     for row in rows:
-        cond, result, window = row.TestCondition, row.RunResult, row.StableWindow
+        cond, result, window = row.TestCondition.to_domain(), row.RunResult, row.StableWindow
         records.append({
             "campaign": row[0], "run_id": row.run_id, "raw_file_version": row.version,
             "raw_file_path": row.path, "raw_file_sha256": row.sha256,
             "raw_file_missing": row.missing_since is not None,
             **wheel_columns(row.Wheel), "soil": row[7], "mode": cond.mode,
             "multipass": cond.multipass,
-            "load_set_n": cond.load_n, "slip_setpoint": cond.slip_setpoint,
-            "velocity_set_mps": cond.velocity_mps, "gravity_mps2": cond.gravity_mps2,
+            "load_set_n": cond.load_set_n, "slip_setpoint": cond.slip_setpoint,
+            "velocity_set_mps": cond.velocity_set_mps, "gravity_mps2": cond.gravity_mps2,
             "steer_deg": cond.steer_deg, "status": result.status,
             "flags": "; ".join(result.flags), "window_found": window.found,
             "window_start_s": window.start_s, "window_end_s": window.end_s,

@@ -20,7 +20,8 @@ from traceability.hashing import content_sha256
 from traceability.provenance import lock_sha256, swtlab_version
 from traceability.text import TextRefused, checked_name
 from traceability.models import (Calibration, Campaign, ProcessingRecord, RawFile, Run, Soil,
-                                 TestCondition, Wheel)
+                                 TestCondition, Wheel, condition_columns)
+from swtlab_base.errors import InputError
 
 
 class StoreOutcome(enum.Enum):
@@ -30,7 +31,7 @@ class StoreOutcome(enum.Enum):
     UNCHANGED = "unchanged"
 
 
-class RunIdClaimed(ValueError):
+class RunIdClaimed(InputError, ValueError):
     """A file claims the run_id of a run stored from another file."""
 
 
@@ -62,11 +63,8 @@ def _condition(session: Session, campaign: Campaign, meta: Any) -> TestCondition
     if wheel.mass_kg is None and w.mass_kg is not None:
         wheel.mass_kg = w.mass_kg
     soil = _get_or_create(session, Soil, name=meta.run.soil)
-    r = meta.run
     return _get_or_create(session, TestCondition, campaign_id=campaign.id, wheel_id=wheel.id,
-                          soil_id=soil.id, mode=r.mode, multipass=r.multipass, load_n=r.load_n,
-                          slip_setpoint=r.slip_setpoint, velocity_mps=r.velocity_mps,
-                          gravity_mps2=r.gravity_mps2, steer_deg=r.steer_deg)
+                          soil_id=soil.id, **condition_columns(meta.run.condition))
 
 
 def _calibrations(meta: Any) -> list[Calibration]:

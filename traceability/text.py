@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from traceability.models import MESSAGE_CHARS, NAME_CHARS
+from swtlab_base.errors import InputError
 
 #: UTF-8 bytes of a name: the bound that keeps a unique index on it within PostgreSQL's
 #: B-tree row limit (2,704 bytes) with the other key columns
 NAME_BYTES = 2000
 
 
-class TextRefused(ValueError):
+class TextRefused(InputError, ValueError):
     """A name the database cannot hold as written (too long, a NUL, not encodable)."""
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from fitting.curve import DEGREES, QUANTITY_UNITS
+from swtlab_base.errors import InputError
 
 FORMAT = "swtlab-wpm/1"
 MAX_DEGREE = max(DEGREES)
@@ -22,7 +23,7 @@ WHEEL_GEOMETRY_KEY = "wheel_geometry"
 WHEEL_KEYS = ("radius_m", "width_m", "grouser_count", "grouser_height_m", "stiffness_n_per_mm")
 
 
-class WpmFormatError(ValueError):
+class WpmFormatError(InputError, ValueError):
     """A WPM CSV that does not follow docs/wpm-csv.md; names file, line and problem."""
 
     def __init__(self, path, line: int, problem: str) -> None:
@@ -30,6 +31,6 @@ class WpmFormatError(ValueError):
         self.path, self.line, self.problem = str(path), line, problem
 
 
-class WpmSelectionError(ValueError):
+class WpmSelectionError(InputError, ValueError):
     """A query the loaded curves cannot answer unambiguously (no or several matching curve
     sets, a quantity the set lacks); lists the choices."""

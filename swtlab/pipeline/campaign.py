@@ -9,14 +9,16 @@ from typing import Any
 import pandas as pd
 
 from swtlab_base.domain import Wheel, check_results, wheels_of
+from swtlab_base.errors import InputError
 
 
 @dataclass(frozen=True)
 class Failure:
     """A run (or part of one) that could not be processed: the ``file``, the ``stage``
     (``ingest``, ``results``, ``soil_flow``, ``store``), the one-line ``reason`` and the
-    ``error_type``, the exception's class name (``IngestError`` for a run ingest refused with
-    its own message; any other type is a fault of swtlab inside that run: please report it)."""
+    ``error_type``, the exception's class name, kept as a record (an ``IngestError`` for a run
+    ingest refused; the reason of an error that is no :class:`~swtlab_base.errors.InputError`
+    says "internal error": a fault of swtlab inside that run, please report it)."""
 
     file: str
     stage: str
@@ -26,9 +28,10 @@ class Failure:
     @classmethod
     def of(cls, file: str | Path, stage: str, error: BaseException) -> Failure:
         """The failure of ``stage`` on ``file`` from the exception it raised: its own message
-        for an ``IngestError``, else ``internal error (<type>: <message>)``, on one line."""
+        for an :class:`~swtlab_base.errors.InputError` (the user's input), else
+        ``internal error (<type>: <message>)``, on one line."""
         kind = type(error).__name__
-        text = str(error) if kind == "IngestError" else f"internal error ({kind}: {error})"
+        text = str(error) if isinstance(error, InputError) else f"internal error ({kind}: {error})"
         return cls(str(file), stage, one_line(text), kind)
 
 

@@ -21,5 +21,5 @@ def report(campaign: Campaign, path: str | Path) -> dict[str, Path]:
         return {name: write_report(campaign.source, page, name) for name, page in pages.items()}
     results = [r.result for r in campaign.runs if r.result is not None]
     return {name: render_report(from_results(name, [r for r in results
-                                                    if r.condition["campaign"] == name]), page)
+                                                    if r.campaign == name]), page)
             for name, page in pages.items()}

@@ -7,10 +7,16 @@ the two (:func:`fit_sigma`).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
 import numpy as np
 import pandas as pd
 
 from swtlab_base.domain.results import not_measured_text
+
+if TYPE_CHECKING:
+    from pandas.core.groupby import DataFrameGroupBy
 
 #: the columns that make two runs replicates of one condition
 REPLICATE_KEY = ("wheel", "soil", "mode", "multipass", "load_set_n", "slip_setpoint",
@@ -50,7 +56,7 @@ def _within_u(table: pd.DataFrame, quantity: str) -> pd.Series:
     return u.astype(float).fillna(se.astype(float)) if se is not None else u.astype(float)
 
 
-def _groups(table: pd.DataFrame):
+def _groups(table: pd.DataFrame) -> DataFrameGroupBy | None:
     """The runs with a stable phase grouped by condition; None when the table lacks a column
     of :data:`REPLICATE_KEY` (then no two runs can be told to be replicates)."""
     if any(c not in table for c in REPLICATE_KEY):
@@ -59,7 +65,8 @@ def _groups(table: pd.DataFrame):
     return usable.groupby(list(REPLICATE_KEY), dropna=False, sort=True)
 
 
-def replicate_spread(table: pd.DataFrame, quantities=QUANTITIES) -> pd.DataFrame:
+def replicate_spread(table: pd.DataFrame, quantities: Iterable[str] = QUANTITIES
+                     ) -> pd.DataFrame:
     """One row per (condition with >= 2 runs with a stable phase, quantity): the condition,
     ``runs``, ``run_ids``, ``mean`` of the runs' means, ``replicate_sd`` (their sample
     standard deviation), ``within_u`` (RMS of the runs' own uncertainties), ``ratio``

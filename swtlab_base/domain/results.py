@@ -12,6 +12,8 @@ mean, corrected for autocorrelation), and its uncertainty budget (:data:`BUDGET_
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 import pandas as pd
 
@@ -62,13 +64,13 @@ BUDGET_COLUMNS = ("u", "u95", "k", "dof", "correction", *(f"u_{t}" for t in UNCE
 NOT_MEASURED = "not_measured"
 
 
-def not_measured_text(items) -> str:
+def not_measured_text(items: Iterable[str]) -> str:
     """The ``not_measured`` column of a run: its budgets' ``not_measured`` items, each once,
     sorted, ``'; '``-separated."""
     return "; ".join(sorted(set(items)))
 
 
-def not_measured_heads(text) -> list[str]:
+def not_measured_heads(text: object) -> list[str]:
     """The items of a ``not_measured`` cell without their explanations (the text before
     ``' ('``), for a summary."""
     if not isinstance(text, str) or not text:

@@ -13,7 +13,7 @@ WHEEL_SIZE_REL_TOL = 0.02
 GROUSER_HEIGHT_TOL_M = 0.001
 
 
-def _finite(name: str, value, minimum: float, strict: bool) -> None:
+def _finite(name: str, value: object, minimum: float, strict: bool) -> None:
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
         raise ValueError(f"wheel {name} {value!r} must be a finite number")
     if value < minimum or (strict and value == minimum):

@@ -11,13 +11,15 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
 
+from swtlab_base.errors import InputError
+
 STANDARD_GRAVITY_MPS2 = 9.80665
 MODES = ("speed_control", "towed", "free_sled")
 #: keys a truth must give for every condition (SI units; slip per the raw-run spec)
 TRUTH_KEYS = ("slip", "travel_velocity_mps", "wheel_load_n", "dp_n", "torque_nm", "sinkage_m")
 
 
-class SecondRigError(ValueError):
+class SecondRigError(InputError, ValueError):
     """Bad input to the second rig (one line)."""
 
 
