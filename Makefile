@@ -47,6 +47,7 @@ demo: $(STAMP)
 # worker, so module fixtures run once. The 15 slowest tests are printed to keep the suite fast.
 test: $(STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/mypy
 	$(BIN)/python -m pytest -q -n auto --dist loadfile --durations=15
 
 bench: $(STAMP)
