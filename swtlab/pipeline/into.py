@@ -126,7 +126,7 @@ def process_into(db_url: str, folder: str | Path, channel_map: str | None = None
                                 for f in processed.failures if f.stage == "soil_flow"]
     batch.missing = in_transaction(session_factory, lambda session: [
         f"{row.path} (run {row.run.run_id})" for row in mark_missing(session, folder)])
-    changed = {r.result.condition.get("campaign") for r in pooled}
+    changed = {r.result.campaign for r in pooled}
     again = [(p, c) for p, c, campaign in current if campaign in changed]
     if again:  # their campaign's pool changed: their budgets are made again (no soil flow)
         pooled += [r for r in process_files([p for p, _ in again],
