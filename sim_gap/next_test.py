@@ -382,11 +382,11 @@ def next_tests(sim: Simulated, points: pd.DataFrame, obs: Observations,
                eta: float, apart_sd: float) -> list[dict]:
     """The tests of :func:`candidate_tests` (and the replicates) by expected information gain
     about the effect set: ``{kind, test, gain_bits, n_runs, conditions}``, largest gain
-    first. ``hypotheses``: the report's (``key``, ``laws``, ``effects``,
-    ``probability``); ``fits``: each named key's MAP fit (a free form: its base fit);
-    ``evidence``: each key's (the discrepancy's and the nugget's posterior sizes);
-    ``eta``: the diagnosis' learning rate (:func:`sim_gap.decide.learning_rate`); ``apart_sd``: the amplitude (floor units) of a discrepancy apart per
-    level, for the free forms and "outside the candidates"."""
+    first. ``hypotheses``: the report's (``key``, ``laws``, ``effects``, ``probability``);
+    ``fits``: each named key's MAP fit (a free form: its base fit); ``evidence``: each key's
+    (the discrepancy's and the nugget's posterior sizes); ``eta``: the diagnosis' learning
+    rate (:func:`sim_gap.decide.learning_rate`); ``apart_sd``: the amplitude (floor units) of
+    a discrepancy apart per level, for the free forms and "outside the candidates"."""
     lead = leading(hypotheses)
     if len({_label(h) for h in lead}) < 2:
         return []
