@@ -20,7 +20,11 @@ of :mod:`sim_gap.evidence` at its MAP ``u*``:
   noise and the nugget (its posterior RMS size) + the discrepancy's posterior covariance.
   A free-form level effect and "outside the candidates" carry their discrepancy apart per
   level (the middle of its amplitude grid): known where the campaign ran that level, fresh
-  at a level (a wheel, a pass, a gravity) it has not run.
+  at a level (a wheel, a pass, a gravity) it has not run. A multipass or gravity level the
+  campaign has not run makes that factor's effect a hypothesis (it needs two levels), and
+  that effect could carry whatever the new level shows: every hypothesis gets the fresh
+  discrepancy apart there, so a new level tells the hypotheses apart only by what they
+  predict there beyond it (not by the mere fact that something changes).
 
 ``p(y | H)`` is the mixture of the laws of ``H`` (their posterior weights); ``H[y]`` and
 ``H[y | H]`` are estimated by Monte Carlo over the mixture, :data:`DRAWS` draws per
@@ -93,6 +97,8 @@ LOAD_BELOW, LOAD_ABOVE, LOAD_GAP_RATIO = 0.6, 1.5, 1.5
 REPLICATE_CONDITIONS, REPLICATE_RUNS = 3, 2
 #: gravity levels proposed when a campaign has one
 PROPOSED_GRAVITY_MPS2 = (MARS_GRAVITY_MPS2, MOON_GRAVITY_MPS2)
+#: factors whose effect becomes a hypothesis once a campaign has two of their levels
+NEW_LEVEL_FACTORS = ("multipass", "gravity_mps2")
 #: finite-difference step of the Jacobian, in units of each parameter's internal range
 JACOBIAN_STEP = 1e-3
 
@@ -141,10 +147,14 @@ def candidate_tests(points: pd.DataFrame, grousered: bool) -> list[dict]:
     level_loads = loads[[0, -1]] if loads.size > 1 else loads
     out = []
 
+    each = f" on each of the {len(wheels)} measured wheels" if len(wheels) > 1 else ""
+
     def add(kind, text, grid):
-        grid = new_conditions(points, grid) if kind != "replicates" else grid
+        grid = new_conditions(points, grid)
         if len(grid):
-            out.append({"kind": kind, "test": f"{text} ({_runs_text(grid)})", "points": grid})
+            where = "" if kind == "smooth wheel" else each
+            out.append({"kind": kind, "test": f"{text}{where} ({_runs_text(grid)})",
+                        "points": grid})
 
     below, above = round(LOAD_BELOW * loads[0]), round(LOAD_ABOVE * loads[-1])
     add("load", f"a set load of {below:.0f} N, below the tested ones, at slips "
@@ -215,7 +225,9 @@ def _replicates(points: pd.DataFrame, spread: np.ndarray) -> dict | None:
         c for c in WHEEL_KEY if c in points]
     chosen = points.iloc[order][cols]
     grid = pd.concat([chosen] * REPLICATE_RUNS, ignore_index=True)
-    where = "; ".join(f"{r.load_set_n:.0f} N, slip {r.slip:.2g}" for r in chosen.itertuples())
+    named = "source" in points and points["source"].nunique() > 1
+    where = "; ".join((f"{r.source}: " if named else "") + f"{r.load_set_n:.0f} N, slip "
+                      f"{r.slip:.2g}" for r in chosen.itertuples())
     return {"kind": "replicates", "test": f"{REPLICATE_RUNS} more runs at each of the measured "
             f"conditions {where} ({_runs_text(grid)})", "points": grid}
 
@@ -252,8 +264,7 @@ class _Hypothesis:
 
     def __init__(self, sim: Simulated, points: pd.DataFrame, obs: Observations, f: MapFit,
                  e: Evidence, apart_by: str | None, apart_sd: float) -> None:
-        self.f, self.apart_by = f, apart_by
-        self.apart_sd = apart_sd if apart_by is not None else 0.0
+        self.f, self.apart_by, self.apart_sd = f, apart_by, apart_sd
         self.tau, self.nugget = e.tau_mean, e.nugget_rms
         self.groups = _levels(points, apart_by)[obs.point] if apart_by else None
         c = f.fit.candidate
@@ -313,16 +324,25 @@ def predictive(sim: Simulated, points: pd.DataFrame, obs: Observations, h: _Hypo
     w = solve_triangular(h.lower, k_no.T, lower=True, check_finite=False)
     cov = jac @ h.s_post @ jac.T + np.diag(noise ** 2) + k_nn - w.T @ w
     mean = mean + k_no @ h.alpha
+    for factor in NEW_LEVEL_FACTORS:  # a level not run: its effect can carry anything there
+        if h.apart_by == factor:  # its own discrepancy apart is fresh there already
+            continue
+        old = set(_levels(points, factor))
+        levels = _levels(grid, factor)[point]
+        fresh = np.array([x not in old for x in levels])
+        same = (levels[:, None] == levels[None, :]) & fresh[:, None] & fresh[None, :]
+        cov = cov + h.apart_sd ** 2 * np.where(same, cross_kernel(new, new), 0.0)
     return mean, 0.5 * (cov + cov.T)
 
 
 def _levels(frame: pd.DataFrame, by: str) -> np.ndarray:
-    """Per row, its level of the factor ``by`` (a column, or source, multipass and gravity
-    together for "outside the candidates", as :func:`sim_gap.evidence.observations` groups)."""
+    """Per row, its level of the factor ``by`` (a column; the source for "outside the
+    candidates": an unknown effect seen on a source is expected to persist at that source's
+    new multipass or gravity levels, where the factor's own effect may add to it; the
+    evidence groups by source and level, :func:`sim_gap.evidence.observations`)."""
     if by == OUTSIDE:
         source = frame["source"] if "source" in frame else pd.Series([""] * len(frame))
-        return np.array([f"{s}|{m}|{g:.4f}" for s, m, g in zip(
-            source, frame["multipass"], frame["gravity_mps2"])])
+        return source.astype(str).to_numpy()
     return frame[by].astype(str).to_numpy() if by != "gravity_mps2" else \
         frame[by].round(4).astype(str).to_numpy()
 
