@@ -226,8 +226,12 @@ def _replicates(points: pd.DataFrame, spread: np.ndarray) -> dict | None:
     chosen = points.iloc[order][cols]
     grid = pd.concat([chosen] * REPLICATE_RUNS, ignore_index=True)
     named = "source" in points and points["source"].nunique() > 1
+    passes = points["multipass"].nunique() > 1
+    gravities = points["gravity_mps2"].round(4).nunique() > 1
     where = "; ".join((f"{r.source}: " if named else "") + f"{r.load_set_n:.0f} N, slip "
-                      f"{r.slip:.2g}" for r in chosen.itertuples())
+                      f"{r.slip:.2g}" + (f", multipass {r.multipass}" if passes else "")
+                      + (f", {r.gravity_mps2:.3g} m/s^2" if gravities else "")
+                      for r in chosen.itertuples())
     return {"kind": "replicates", "test": f"{REPLICATE_RUNS} more runs at each of the measured "
             f"conditions {where} ({_runs_text(grid)})", "points": grid}
 
