@@ -303,13 +303,14 @@ def _prediction(sim: Simulated, h: _Hypothesis, grid: pd.DataFrame, quantities: 
     return mean, jac
 
 
-def predictive(sim: Simulated, points: pd.DataFrame, obs: Observations, h: _Hypothesis,
-               grid: pd.DataFrame, quantities: list[str], noise_ratio: dict[str, float]
+def predictive(radius_m: float, points: pd.DataFrame, obs: Observations, h: _Hypothesis,
+               grid: pd.DataFrame, prediction: tuple[np.ndarray, np.ndarray],
+               quantities: list[str], noise_ratio: dict[str, float]
                ) -> tuple[np.ndarray, np.ndarray]:
     """Mean and covariance of a test's outcome (flat) under one hypothesis (module
-    docstring)."""
-    mean, jac = _prediction(sim, h, grid, quantities)
-    point, qi, floor = _entries(grid, quantities, sim.radius_m)
+    docstring), from its MAP ``prediction`` at ``grid`` and Jacobian (:func:`_prediction`)."""
+    mean, jac = prediction
+    point, qi, floor = _entries(grid, quantities, radius_m)
     noise = floor * np.hypot(np.array([noise_ratio[q] for q in quantities])[qi], h.nugget)
     new = (grid["slip"].to_numpy(float)[point], grid["wheel_load_n"].to_numpy(float)[point],
            qi, floor)
@@ -427,14 +428,14 @@ def next_tests(sim: Simulated, points: pd.DataFrame, obs: Observations,
     spread = _spread(sim, points, models, quantities, ratio)
     if (rep := _replicates(points, spread)) is not None:
         tests.append(rep)
+    grids = [_with_wheel(sim, t["points"]) for t in tests]
+    at = _predictions(new_sim, models, grids, quantities)
     out = []
-    for t in tests:
-        grid = _with_wheel(sim, t["points"])
-        try:
-            pred = [predictive(new_sim, points, obs, m, grid, quantities, ratio)
-                    for m in models]
-        except ValueError:  # a tabulated simulation that does not reach these conditions
+    for t, grid, first in zip(tests, grids, at):
+        if first is None:  # a tabulated simulation that does not reach these conditions
             continue
+        pred = [predictive(sim.radius_m, points, obs, m, grid, f, quantities, ratio)
+                for m, f in zip(models, first)]
         if not all(np.all(np.isfinite(m)) for m, _ in pred):
             continue
         gain = information_gain([m for m, _ in pred], [c / eta for _, c in pred], weights,
@@ -442,6 +443,27 @@ def next_tests(sim: Simulated, points: pd.DataFrame, obs: Observations,
         out.append({"kind": t["kind"], "test": t["test"], "gain_bits": round(gain, 3),
                     "n_runs": len(grid), "conditions": _conditions(t["points"])})
     return sorted(out, key=lambda t: -t["gain_bits"])
+
+
+def _predictions(sim: Simulated, models: list[_Hypothesis], grids: list[pd.DataFrame],
+                 quantities: list[str]) -> list[list | None]:
+    """Per test, each hypothesis' MAP prediction and Jacobian (:func:`_prediction`), all
+    tests in one evaluation per parameter step; test by test (None where the simulation
+    does not reach it) when a tabulated simulation refuses the whole."""
+    try:
+        whole = [_prediction(sim, m, pd.concat(grids, ignore_index=True), quantities)
+                 for m in models]
+    except ValueError:
+        out = []
+        for grid in grids:
+            try:
+                out.append([_prediction(sim, m, grid, quantities) for m in models])
+            except ValueError:
+                out.append(None)
+        return out
+    edges = np.cumsum([0] + [len(g) * len(quantities) for g in grids])
+    return [[(mean[a:b], jac[a:b]) for mean, jac in whole]
+            for a, b in zip(edges[:-1], edges[1:])]
 
 
 def _label(h: dict) -> str:
