@@ -215,15 +215,19 @@ def new_conditions(points: pd.DataFrame, grid: pd.DataFrame) -> pd.DataFrame:
 
 
 def _replicates(points: pd.DataFrame, spread: np.ndarray) -> dict | None:
-    """Replicates at the :data:`REPLICATE_CONDITIONS` measured conditions where the leading
-    hypotheses' predictions spread most (``spread``: per point, in noise units)."""
-    order = np.argsort(-np.nan_to_num(spread, nan=-1.0))[:REPLICATE_CONDITIONS]
-    if not order.size:
-        return None
+    """Replicates at the :data:`REPLICATE_CONDITIONS` measured conditions (distinct: slip to
+    0.01) where the leading hypotheses' predictions spread most (``spread``: per point, in
+    noise units)."""
     cols = (["source"] if "source" in points else []) + [
         "load_set_n", "wheel_load_n", "slip", "multipass", "gravity_mps2"] + [
         c for c in WHEEL_KEY if c in points]
-    chosen = points.iloc[order][cols]
+    order = np.argsort(-np.nan_to_num(spread, nan=-1.0))
+    ranked = points.iloc[order][cols]
+    same = ranked.assign(slip=ranked["slip"].round(2), gravity_mps2=ranked["gravity_mps2"].round(3))
+    key = [c for c in same if c != "wheel_load_n"]  # the measured load differs run to run
+    chosen = ranked[~same.duplicated(key)].iloc[:REPLICATE_CONDITIONS]
+    if chosen.empty:
+        return None
     grid = pd.concat([chosen] * REPLICATE_RUNS, ignore_index=True)
     named = "source" in points and points["source"].nunique() > 1
     passes = points["multipass"].nunique() > 1

@@ -138,7 +138,8 @@ def run_campaign(folder: Path, out: Path, seed: int, boot: int) -> dict | None:
     rng = np.random.default_rng([seed, truth["index"]])
     picks = {"top": tests[0], "random": tests[int(rng.integers(len(tests)))]}
     result = {"campaign": folder.name, "class": truth["class"],
-              "truth": "+".join(truth["effects"] + truth["outside"]) or "none"}
+              "truth": "+".join(truth["effects"] + truth["outside"]) or "none",
+              "p_true": score_campaign(folder, truth)["p_true"]}
     for arm, test in picks.items():
         document = write_followup(folder, out, truth, arm, test)
         diagnose(out / document["campaign"], boot)
@@ -146,7 +147,8 @@ def run_campaign(folder: Path, out: Path, seed: int, boot: int) -> dict | None:
         result[arm] = {"test": test["test"], "gain_bits": test["gain_bits"],
                        "runs": document["followup"]["runs"], "verdict": row["verdict"],
                        "outcome": row["outcome"], "resolved": resolved(row, truth),
-                       "p_leading": row["p_leading"], "leading": row["leading"]}
+                       "p_leading": row["p_leading"], "leading": row["leading"],
+                       "p_true": row["p_true"]}
     return result
 
 
