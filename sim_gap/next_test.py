@@ -41,8 +41,10 @@ Only the leading hypotheses that together hold :data:`POSTERIOR_COVERED` of the 
 enter (renormalised). The noise of a new run is the campaign's: per quantity, the median
 ratio of the points' noise (:func:`sim_gap.fit.sigmas`: measured repeatability where there
 are replicates) to the repeatability floor (:func:`sim_gap.vocabulary.model_error_floor`),
-times the floor at the new conditions. Left out: a relative sinkage's unknown zero (a test
-then gains only from forces and torque).
+times the floor at the new conditions. A test's outcome is what the campaign measures, less
+the motion resistance where drawbar pull and torque are measured (it is computed from them:
+:func:`sim_gap.fit.independent_entries`) and a relative sinkage (its unknown zero is left out
+of the predictive: the test then gains from forces and torque only).
 
 The tests a lab can run, never at a condition the campaign already has (same wheel, set load
 within :data:`LOAD_TOLERANCE`, multipass, gravity, slip within :data:`SLIP_TOLERANCE`)
@@ -421,6 +423,8 @@ def next_tests(sim: Simulated, points: pd.DataFrame, obs: Observations,
         return []
     quantities = [q for q in quantities_of(points)
                   if not (q == "sinkage_m" and points.attrs.get("sinkage_relative"))]
+    if {"resistance_n", "dp_n", "torque_nm"} <= set(quantities):
+        quantities.remove("resistance_n")  # computed from them (fit.independent_entries)
     ratio = _noise_ratio(points, sim.radius_m)
     models = [_Hypothesis(sim, points, obs, fits.get(h["key"], fits["soil_only"]),
                           evidence[h["key"]], _apart(h), apart_sd) for h in lead]
