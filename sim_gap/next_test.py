@@ -106,10 +106,11 @@ JACOBIAN_STEP = 1e-3
 
 
 def _wheels(points: pd.DataFrame) -> pd.DataFrame:
-    """One row per measured source: its name and wheel columns (when the points have them)."""
+    """One row per measured source: its name and wheel columns (when the points have them;
+    points without sources are one, named "" as :func:`_levels` names it)."""
     cols = ["source"] + [c for c in WHEEL_KEY if c in points]
     if "source" not in points:
-        return pd.DataFrame({"source": [str(points.attrs.get("source", ""))]})
+        return pd.DataFrame({"source": [""]})
     return points[cols].drop_duplicates("source").reset_index(drop=True)
 
 
@@ -135,7 +136,9 @@ def _slips_text(slips) -> str:
 
 
 def _loads_text(loads) -> str:
-    return " and ".join(f"{w:.0f} N" for w in loads)
+    """``80 N``, ``56 and 186 N``, ``56, 120 and 186 N``."""
+    names = [f"{w:.0f}" for w in loads]
+    return (", ".join(names[:-1]) + " and " if len(names) > 1 else "") + names[-1] + " N"
 
 
 def candidate_tests(points: pd.DataFrame, grousered: bool) -> list[dict]:
