@@ -241,8 +241,8 @@ def _replicates(points: pd.DataFrame, spread: np.ndarray) -> dict | None:
                       f"{r.slip:.2g}" + (f", multipass {r.multipass}" if passes else "")
                       + (f", {r.gravity_mps2:.3g} m/s^2" if gravities else "")
                       for r in chosen.itertuples())
-    return {"kind": "replicates", "test": f"{REPLICATE_RUNS} more runs at each of the measured "
-            f"conditions {where} ({_runs_text(grid)})", "points": grid}
+    return {"kind": "replicates", "test": f"repeat the measured conditions {where}, "
+            f"{REPLICATE_RUNS} more runs each ({_runs_text(grid)})", "points": grid}
 
 
 def _noise_ratio(points: pd.DataFrame, radius_m: float) -> dict[str, float]:
