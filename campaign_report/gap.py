@@ -155,6 +155,25 @@ def _region_text(report: dict, where: dict) -> str | None:
             f" (z = {region['z_soil_recalibrated']:.1f}).")
 
 
+def next_tests_text(report: dict) -> str | None:
+    """Schema 2, inconclusive: the tests that would tell most about which explanation is
+    right, by their expected information gain (``next_tests``, at most three)."""
+    tests = report.get("next_tests") or []
+    if not tests:
+        return None
+    parts = [f"{i}. {_units(t['test'])}: expected gain {t['gain_bits']:.2f} bit"
+             for i, t in enumerate(tests, 1)]
+    return ("Next test, by the information it is expected to give about which explanation is "
+            f"right (the probabilities above leave {_entropy_bits(report):.2f} bit uncertain): "
+            + "; ".join(parts) + ".")
+
+
+def _entropy_bits(report: dict) -> float:
+    """The entropy of the effect sets' probabilities, in bits: what a test could tell."""
+    p = [s["probability"] for s in report["effect_sets"] if s["probability"] > 0]
+    return -sum(x * math.log2(x) for x in p)
+
+
 def decisive_test_text(report: dict) -> str | None:
     """The next test in words: the extra test that would tell the two leading named
     hypotheses apart, or, for a gap outside the candidates, where it is largest."""
@@ -388,8 +407,9 @@ def _verdict_blocks(report: dict) -> list[Block]:
     blocks: list[Block] = [Heading(f"Verdict: {heading}"),
                            Note(rule, warning=verdict == "inconclusive"),
                            Note(f"Reason, as the diagnosis writes it: {report['reason']}")]
-    if (test := decisive_test_text(report)) is not None:
-        blocks.append(Note(test))
+    for test in (next_tests_text(report), decisive_test_text(report)):
+        if test is not None:
+            blocks.append(Note(test))
     return blocks
 
 

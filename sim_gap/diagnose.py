@@ -17,12 +17,12 @@ from threadpoolctl import threadpool_limits
 from sim_gap import candidates as cands
 from sim_gap.crossval import contrasts, cross_validate, folds
 from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate, posterior
-from sim_gap.discriminate import separating_test
 from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances, log_evidence,
                               observations)
 from sim_gap.fit import (MapFit, fit_map, internal_bounds, quantities_of, sigmas, strengths,
                          to_values)
 from sim_gap.hypotheses import OUTSIDE, admissible, hypothesis_priors, param_prior
+from sim_gap.next_test import TOP_TESTS, next_tests
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
 from sim_gap.siblings import contrasts as sibling_contrasts
@@ -268,9 +268,11 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     soil_values = fits["soil_only"].fit.values
     regions = residual_map(points, sim.predict(points, {}), sim.predict(points, soil_values),
                            sim.radius_m)
-    if decision["verdict"] == "inconclusive" and len(leaders) == 2:
-        decision["separating_test"] = separating_test(sim, points, fits[leaders[0]].fit.values,
-                                                      fits[leaders[1]].fit.values)
+    if decision["verdict"] == "inconclusive":
+        decision["admissible_tests"] = next_tests(
+            sim, points, obs, hypotheses, fits, evidence, eta,
+            float(np.sqrt(amplitudes[0] * amplitudes[-1])))
+        decision["next_tests"] = decision["admissible_tests"][:TOP_TESTS]
     elif decision["verdict"] == OUTSIDE:
         decision["separating_test"] = largest_gap(regions)
     before = cross_validate(sim, fits["soil_only"].fit.candidate, points, sig, None,

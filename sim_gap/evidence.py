@@ -83,12 +83,20 @@ class Observations:
 
 def _unit_kernel(points: pd.DataFrame, point: np.ndarray, quantity: np.ndarray,
                  floor: np.ndarray) -> np.ndarray:
-    slip = points["slip"].to_numpy(float)[point]
-    log_load = np.log(np.maximum(points["wheel_load_n"].to_numpy(float), 1e-9))[point]
-    d2 = (((slip[:, None] - slip[None, :]) / LENGTH_SLIP) ** 2
-          + ((log_load[:, None] - log_load[None, :]) / LENGTH_LOG_LOAD) ** 2)
-    same_q = quantity[:, None] == quantity[None, :]
-    return np.where(same_q, np.exp(-0.5 * d2), 0.0) * floor[:, None] * floor[None, :]
+    entries = (points["slip"].to_numpy(float)[point],
+               points["wheel_load_n"].to_numpy(float)[point], quantity, floor)
+    return cross_kernel(entries, entries)
+
+
+def cross_kernel(a: tuple[np.ndarray, ...], b: tuple[np.ndarray, ...]) -> np.ndarray:
+    """The shared discrepancy's unit-amplitude covariance between entries ``a`` and ``b``,
+    each ``(slip, wheel load N, quantity index, floor)`` (flat arrays)."""
+    (slip_a, load_a, q_a, f_a), (slip_b, load_b, q_b, f_b) = a, b
+    log_a, log_b = np.log(np.maximum(load_a, 1e-9)), np.log(np.maximum(load_b, 1e-9))
+    d2 = (((slip_a[:, None] - slip_b[None, :]) / LENGTH_SLIP) ** 2
+          + ((log_a[:, None] - log_b[None, :]) / LENGTH_LOG_LOAD) ** 2)
+    same_q = q_a[:, None] == q_b[None, :]
+    return np.where(same_q, np.exp(-0.5 * d2), 0.0) * f_a[:, None] * f_b[None, :]
 
 
 def observations(points: pd.DataFrame, sigma: dict[str, np.ndarray], radius_m: float
@@ -165,10 +173,17 @@ def _log_interval(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class Evidence:
     """Log evidence (natural log) and the posterior weights of the shared discrepancy's sizes
-    (:data:`TAU_GRID`, summed over the other grids)."""
+    (:data:`TAU_GRID`, summed over the other grids) and of the nugget's
+    (:data:`NUGGET_GRID`)."""
 
     log_evidence: float
     tau_weights: np.ndarray
+    nugget_weights: np.ndarray | None = None
+
+    @property
+    def nugget_rms(self) -> float:
+        """Posterior root-mean-square size of the nugget (floor units)."""
+        return float(np.sqrt(self.nugget_weights @ NUGGET_GRID ** 2))
 
     @property
     def tau_mean(self) -> float:
@@ -220,7 +235,7 @@ def log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np
             lo, hi = bounds_from_prior
             logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)
                               - _log_interval(lo / prior_sd, hi / prior_sd))
-    logs = logs.reshape(len(TAU_GRID), -1) - np.log(logs.size)
+    logs = logs.reshape(cov.shape) - np.log(logs.size)
     total = float(logsumexp(logs))
-    weights = np.exp(logsumexp(logs, axis=1) - total)
-    return Evidence(total, weights)
+    weights = np.exp(logsumexp(logs, axis=(1, 2)) - total)
+    return Evidence(total, weights, np.exp(logsumexp(logs, axis=(0, 1)) - total))

@@ -101,8 +101,10 @@ def run(args: argparse.Namespace) -> int:
     print("reason:", report["reason"])
     for entry in report["effect_sets"][:3]:
         print(f"  P({entry['label']}) = {entry['probability']:.3f}")
+    for test in report.get("next_tests") or []:
+        print(f"next test ({test['gain_bits']:.2f} bits expected): {test['test']}")
     if report.get("separating_test"):
-        print("test that would decide:", report["separating_test"]["test"])
+        print("where the gap is largest:", report["separating_test"]["test"])
     for q, before in report["held_out_rmse_before"].items():
         print(f"{q}: held-out RMSE {before:.4g} -> {report['held_out_rmse_after'][q]:.4g} "
               f"({report['shrink_pct'][q]:.1f} % shrink)")

@@ -312,6 +312,20 @@ def test_inconclusive_names_the_leaders_and_never_the_outside(report):
     who = f"{candidate_text(first['key'])} and {candidate_text(second['key'])}"
     assert (f"Next test: add skid (braked) slips (-0.5, -0.2); {who} differ there by up to "
             "2.5 σ (σ: the repeatability floor).") in page.text
+    tied["separating_test"] = None
+    tied["next_tests"] = [
+        {"kind": "smooth wheel", "test": "a smooth wheel (same rim, no grousers) on the same "
+         "soil at 80 N, slips 0.2, 0.4 (2 runs)", "gain_bits": 0.52, "n_runs": 2},
+        {"kind": "gravity", "test": "another gravity level (3.71 m/s^2: a gravity-offload rig "
+         "or a parabolic flight) at 80 N, slips 0.2 (1 run)", "gain_bits": 0.314, "n_runs": 1}]
+    entropy = -sum(s["probability"] * math.log2(s["probability"])
+                   for s in tied["effect_sets"] if s["probability"] > 0)
+    assert (f"Next test, by the information it is expected to give about which explanation is "
+            f"right (the probabilities above leave {entropy:.2f} bit uncertain): 1. a smooth "
+            "wheel (same rim, no grousers) on the same soil at 80 N, slips 0.2, 0.4 (2 runs): "
+            "expected gain 0.52 bit; 2. another gravity level (3.71 m/s²: a gravity-offload "
+            "rig or a parabolic flight) at 80 N, slips 0.2 (1 run): expected gain 0.31 bit."
+            ) in verdict_words(tied).text
     assert not any(w in text for w in OUTSIDE_WORDS)
     region = report["regions"][0]  # a region test (written for an outside verdict) is not told
     tied["separating_test"] = {"test": "no candidate test separates: the gap lies outside the "

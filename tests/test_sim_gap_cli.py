@@ -20,6 +20,7 @@ from traceability.models import GapReport
 
 REQUIRED = {"verdict", "probability", "hypotheses", "effect_sets", "held_out_rmse_before",
             "held_out_rmse_after", "shrink_pct", "regions", "reason", "separating_test",
+            "next_tests", "admissible_tests",
             "untestable_effects"}
 
 

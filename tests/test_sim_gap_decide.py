@@ -14,7 +14,6 @@ from sim_gap import candidates
 from sim_gap.decide import (CALL_PROBABILITY, by_effect_set, decide, learning_rate,
                             posterior)
 from sim_gap.diagnose import Settings, diagnose
-from sim_gap.discriminate import separating_test
 from sim_gap.evidence import NUGGET_GRID, TAU_GRID, Observations, covariances, log_evidence
 from sim_gap.hypotheses import (OUTSIDE, P_EFFECT, admissible, hypothesis_priors,
                                 outside_prior, set_prior)
@@ -225,13 +224,5 @@ def test_sibling_contrast_of_a_known_shift_at_matched_slips():
     assert c["contrast"] == pytest.approx(2.0)
     assert c["u"] == pytest.approx(u_each / np.sqrt(3))
     assert c["predicted"]["grousers"] == pytest.approx(1.5)
-
-
-def test_separating_test_asks_for_the_missing_contrast():
-    points = synthetic_points(BASE, multipass=(0,), slips=(0.2, 0.5))
-    test = separating_test(Simulated(BASE), points, {},
-                           {"effects.multipass.stiffness_gain_per_pass": 0.4})
-    assert test["test"] == "run multipass level 1"
-    assert test["separation_sigma"] > 3.0
 
 

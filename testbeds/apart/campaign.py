@@ -92,7 +92,7 @@ def draw_campaign(seed: int, index: int) -> dict:
         scatter_sd = {"kphi_log_sd": float(rng.uniform(0.04, 0.15)),
                       "friction_sd_deg": float(rng.uniform(0.3, 1.2))}
         try:
-            rows = [_row(truth, source, run, scatter_sd, rng) for source, run in plan.runs]
+            rows = [run_row(truth, source, run, scatter_sd, rng) for source, run in plan.runs]
         except NoEquilibrium:
             continue
         if max(r["steady"]["sinkage_m"] for r in rows) > MAX_SINKAGE_RATIO * plan.wheel.radius_m:
@@ -104,8 +104,9 @@ def draw_campaign(seed: int, index: int) -> dict:
                        f"{MAX_SINKAGE_RATIO} of its radius in {MAX_DRAWS} draws")
 
 
-def _row(truth: Truth, source: str, run: RunSpec, scatter_sd: dict,
-         rng: np.random.Generator) -> dict:
+def run_row(truth: Truth, source: str, run: RunSpec, scatter_sd: dict,
+            rng: np.random.Generator) -> dict:
+    """One run: its soil scatter, actual slip, steady values and rig readings."""
     scatter = {"kphi_factor": float(math.exp(rng.normal(0, scatter_sd["kphi_log_sd"]))),
                "friction_deg": float(rng.normal(0, scatter_sd["friction_sd_deg"]))}
     # the drives hold the set slip to about 0.003
@@ -154,7 +155,8 @@ def _geometry(wheel: WheelSpec) -> WheelGeometry:
                          stiffness_n_per_mm=wheel.stiffness_n_per_mm)
 
 
-def _write_text(path: Path, text: str) -> None:
+def write_text(path: Path, text: str) -> None:
+    """``text`` to ``path`` atomically (world-readable)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as f:
         f.write(text)
@@ -183,6 +185,36 @@ def truth_document(drawn: dict) -> dict:
                      for r in drawn["rows"]]}
 
 
+def rig_inputs(rows: list[dict], campaign: str) -> tuple[list[RunCondition], dict]:
+    """The rig's conditions and per-run readings table of ``rows`` (:func:`draw_campaign`'s)
+    for the campaign named ``campaign``."""
+    conditions = [RunCondition(r["run"].run_id, "speed_control", r["run"].load_n,
+                               r["slip_setpoint"], multipass=r["run"].multipass,
+                               gravity_mps2=r["run"].gravity_mps2,
+                               velocity_mps=r["run"].velocity_mps, soil="bin_sand",
+                               campaign=campaign, wheel=_geometry(r["run"].wheel))
+                  for r in rows]
+    table = {r["run"].run_id: {"slip": r["run"].slip,
+                               "travel_velocity_mps": r["run"].velocity_mps,
+                               "wheel_load_n": r["run"].load_n, **r["readings"]}
+             for r in rows}
+    return conditions, table
+
+
+def campaign_names(name: str, plan: Plan) -> dict[str, str]:
+    """The campaign name each source's runs carry (the main wheel's, its smooth twin's)."""
+    return {"main": name + ("_lugged" if plan.wheel.grouser_count else ""),
+            "smooth": f"{name}_smooth"}
+
+
+def lab_rig(seed: int, index: int, plan: Plan) -> Rig:
+    """The campaign's rig: its run length (:func:`timeline`) and whether it writes its
+    calibration uncertainty (drawn per campaign)."""
+    rng = np.random.default_rng([int(seed), int(index), 1])
+    return Rig(timeline=timeline(plan),
+               sensors=SensorModel(write_calibration_uncertainty=bool(rng.random() < 0.5)))
+
+
 def write_campaign_folder(out: str | Path, seed: int, index: int) -> dict:
     """Draw campaign ``index`` of ``seed`` and write it under ``out``; return its truth
     document. Same seed and index, same files."""
@@ -192,33 +224,21 @@ def write_campaign_folder(out: str | Path, seed: int, index: int) -> dict:
     folder = out / name
     if folder.exists():
         shutil.rmtree(folder)
-    rng = np.random.default_rng([int(seed), int(index), 1])
-    rig = Rig(timeline=timeline(plan),
-              sensors=SensorModel(write_calibration_uncertainty=bool(rng.random() < 0.5)))
-    campaign_of = {"main": name + ("_lugged" if plan.wheel.grouser_count else ""),
-                   "smooth": f"{name}_smooth"}
+    rig = lab_rig(seed, index, plan)
+    campaign_of = campaign_names(name, plan)
     for source, part, rig_truth in (("main", folder, "rig"),
                                     ("smooth", folder / "smooth", "rig-smooth")):
         rows = [r for r in drawn["rows"] if r["source"] == source]
         if not rows:
             continue
-        conditions = [RunCondition(r["run"].run_id, "speed_control", r["run"].load_n,
-                                   r["slip_setpoint"], multipass=r["run"].multipass,
-                                   gravity_mps2=r["run"].gravity_mps2,
-                                   velocity_mps=r["run"].velocity_mps, soil="bin_sand",
-                                   campaign=campaign_of[source], wheel=_geometry(r["run"].wheel))
-                      for r in rows]
-        table = {r["run"].run_id: {"slip": r["run"].slip,
-                                   "travel_velocity_mps": r["run"].velocity_mps,
-                                   "wheel_load_n": r["run"].load_n, **r["readings"]}
-                 for r in rows}
-        write_campaign(part, conditions, table, seed * 1000 + index, rig=rig)
+        write_campaign(part, *rig_inputs(rows, campaign_of[source]), seed * 1000 + index,
+                       rig=rig)
         target = out / "truth" / name / rig_truth
         if target.exists():
             shutil.rmtree(target)
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.move(str(part / "truth"), str(target))
-    _write_text(folder / "sim.toml", sim_toml(plan.wheel, drawn["published"]))
+    write_text(folder / "sim.toml", sim_toml(plan.wheel, drawn["published"]))
     document = truth_document(drawn)
-    _write_text(out / "truth" / f"{name}.json", json.dumps(document, indent=1) + "\n")
+    write_text(out / "truth" / f"{name}.json", json.dumps(document, indent=1) + "\n")
     return document

@@ -1,0 +1,87 @@
+"""Follow-up runs on an apart campaign (testbeds.apart.followup): the proposed conditions
+(plain JSON, as a gap report lists them) become runs of the same campaign, its truth
+unchanged, new run ids, the smooth wheel where the proposal has no grousers; the written
+follow-up holds the campaign's runs and the new ones, and its truth document says which test
+was added. In-family: the steady values are checked against the campaign's own truth."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from testbeds.apart.campaign import draw_campaign, write_campaign_folder
+from testbeds.apart.followup import followup_rows, resolved, write_followup
+
+G0 = 9.80665
+
+
+def _lugged_campaign():
+    """The first campaign of seed 1 whose wheel has grousers."""
+    for index in range(40):
+        drawn = draw_campaign(1, index)
+        if drawn["plan"].wheel.grouser_count:
+            return index, drawn
+    raise AssertionError("no lugged campaign in 40")
+
+
+def test_followup_runs_are_the_same_campaigns_at_the_proposed_conditions():
+    index, drawn = _lugged_campaign()
+    load = float(drawn["plan"].loads_n[0])
+    conditions = [{"source": "x", "load_set_n": load, "slip": 0.33, "multipass": 0,
+                   "gravity_mps2": G0},
+                  {"source": "smooth wheel", "load_set_n": load, "slip": 0.33, "multipass": 0,
+                   "gravity_mps2": G0, "grouser_count": 0, "grouser_height_m": 0.0}]
+    rows, failed = followup_rows(drawn, conditions, "top")
+    assert failed == 0 and [r["source"] for r in rows] == ["main", "smooth"]
+    old_ids = {run.run_id for _, run in drawn["plan"].runs}
+    ids = [r["run"].run_id for r in rows]
+    assert len(set(ids)) == 2 and not set(ids) & old_ids
+    main, smooth = rows
+    assert main["run"].wheel == drawn["plan"].wheel
+    assert smooth["run"].wheel.grouser_count == 0
+    assert smooth["run"].wheel.radius_m == drawn["plan"].wheel.radius_m
+    for r in rows:
+        assert r["run"].load_n == load and r["run"].slip == pytest.approx(0.33, abs=0.015)
+        assert r["steady"]["dp_n"] == pytest.approx(
+            drawn["truth"].steady(r["run"], r["scatter"])["dp_n"], rel=1e-12)
+    # same campaign, same arm: the same runs
+    again, _ = followup_rows(drawn, conditions, "top")
+    assert [r["steady"]["dp_n"] for r in again] == [r["steady"]["dp_n"] for r in rows]
+
+
+def test_written_followup_holds_the_campaign_and_the_new_runs(tmp_path):
+    index, drawn = _lugged_campaign()
+    src = tmp_path / "bench"
+    truth = write_campaign_folder(src, 1, index)
+    name = drawn["name"]
+    load = float(drawn["plan"].loads_n[-1])
+    test = {"test": "two runs", "conditions": [
+        {"load_set_n": load, "slip": s, "multipass": 0, "gravity_mps2": G0} for s in (0.6, 0.8)]}
+    out = tmp_path / "followups"
+    doc = write_followup(src / name, out, truth, "top", test)
+    folder = out / f"{name}_top"
+    before = sorted(p.name for p in (src / name / "campaign").iterdir())
+    after = sorted(p.name for p in (folder / "campaign").iterdir())
+    assert set(before) < set(after) and len(after) == len(before) + 2
+    assert doc["followup"] == {"of": name, "arm": "top", "test": "two runs", "runs": 2,
+                               "runs_without_equilibrium": 0}
+    assert len(doc["runs"]) == len(truth["runs"]) + 2
+    assert doc["effects"] == truth["effects"] and doc["soil"] == truth["soil"]
+    assert json.loads((out / "truth" / f"{name}_top.json").read_text()) == json.loads(
+        json.dumps(doc))
+    assert not (folder / "truth").exists() and not (folder / "gap.json").exists()
+
+
+@pytest.mark.parametrize("truth, row, expected", [
+    ({"effects": ["grousers"], "outside": []}, {"verdict": ["grousers"], "outcome": "right"}, True),
+    ({"effects": ["grousers"], "outside": []}, {"verdict": "inconclusive",
+                                                "outcome": "inconclusive"}, False),
+    ({"effects": [], "outside": ["soil_drift"]}, {"verdict": "inconclusive",
+                                                  "outcome": "right"}, False),
+    ({"effects": [], "outside": ["soil_drift"]}, {"verdict": "outside_candidates",
+                                                  "outcome": "right"}, True),
+    ({"effects": [], "outside": []}, {"verdict": [], "outcome": "right"}, True),
+])
+def test_resolved_means_a_right_call(truth, row, expected):
+    assert resolved(row, truth) is expected
