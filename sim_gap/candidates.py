@@ -19,6 +19,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from itertools import combinations
 
+import numpy as np
+import pandas as pd
+
 import terramechanics as tm
 
 
@@ -137,6 +140,15 @@ FREE_FORM = "free_form"
 #: the column of the points that sets each level effect's factor
 LEVEL_FACTOR = {"multipass": "multipass", "reduced_gravity": "gravity_mps2",
                 "grousers": "source"}
+
+
+def level_labels(frame: pd.DataFrame, column: str) -> np.ndarray:
+    """Per row, its level of the factor ``column`` as text (gravity to 1e-4 m/s^2; a frame
+    without sources is one source, "")."""
+    if column not in frame:
+        return np.full(len(frame), "" if column == "source" else "nan", dtype=object)
+    values = frame[column].round(4) if column == "gravity_mps2" else frame[column]
+    return values.astype(str).to_numpy()
 
 
 def with_free_form(c: Candidate, effect: str) -> Candidate:

@@ -158,7 +158,7 @@ def _levels(points: pd.DataFrame, effect: str) -> np.ndarray | None:
         levels = np.array([f"{w.grouser_count} x {w.grouser_height_m:g} m" if (
             w := wheels.get(s)) else "unknown" for s in points["source"]])
     else:
-        levels = points[cands.LEVEL_FACTOR[effect]].round(6).to_numpy()
+        levels = cands.level_labels(points, cands.LEVEL_FACTOR[effect])
     return levels if len(set(levels.tolist())) >= 2 else None
 
 

@@ -178,7 +178,7 @@ class Evidence:
 
     log_evidence: float
     tau_weights: np.ndarray
-    nugget_weights: np.ndarray | None = None
+    nugget_weights: np.ndarray
 
     @property
     def nugget_rms(self) -> float:
@@ -218,6 +218,9 @@ def log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np
     residual = y - np.nan_to_num(predicted, nan=0.0) + jac @ offset_from_prior
     prior_var = prior_sd ** 2
     rhs = np.column_stack([residual, jac])
+    if bounds_from_prior is not None:
+        lo, hi = bounds_from_prior
+        prior_in_box = np.sum(_log_interval(lo / prior_sd, hi / prior_sd))
     logs = np.empty(cov.log_det.size)
     for g, (factor, log_det) in enumerate(zip(cov.lower, cov.log_det)):
         x = solve_triangular(factor, rhs, lower=True, check_finite=False)
@@ -232,9 +235,7 @@ def log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np
         if bounds_from_prior is not None:
             post_cov = cho_solve((m_factor, True), np.eye(b.size), check_finite=False)
             mean, sd = post_cov @ b, np.sqrt(np.diag(post_cov))
-            lo, hi = bounds_from_prior
-            logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)
-                              - _log_interval(lo / prior_sd, hi / prior_sd))
+            logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)) - prior_in_box
     logs = logs.reshape(cov.shape) - np.log(logs.size)
     total = float(logsumexp(logs))
     weights = np.exp(logsumexp(logs, axis=(1, 2)) - total)

@@ -25,6 +25,15 @@ def quantities_of(points: pd.DataFrame) -> list[str]:
     return [q for q in QUANTITIES if q in points]
 
 
+#: a quantity computed from others of the same run: ``R = T/r - DP``
+DERIVED = {"resistance_n": ("dp_n", "torque_nm")}
+
+
+def independent_quantities(quantities: list[str]) -> list[str]:
+    """``quantities`` without those computed from others among them (:data:`DERIVED`)."""
+    return [q for q in quantities if not (q in DERIVED and set(DERIVED[q]) <= set(quantities))]
+
+
 def independent_entries(points: pd.DataFrame) -> np.ndarray:
     """Mask (points x :func:`quantities_of`) of the measured entries that carry information
     of their own: every finite value, except a motion resistance measured beside both the
@@ -32,9 +41,9 @@ def independent_entries(points: pd.DataFrame) -> np.ndarray:
     (counting it again would weigh those two twice, and their errors with them)."""
     quantities = quantities_of(points)
     where = np.isfinite(points[quantities].to_numpy(float))
-    if {"resistance_n", "dp_n", "torque_nm"} <= set(quantities):
-        i = quantities.index
-        where[:, i("resistance_n")] &= ~(where[:, i("dp_n")] & where[:, i("torque_nm")])
+    i = quantities.index
+    for q in set(quantities) - set(independent_quantities(quantities)):
+        where[:, i(q)] &= ~np.logical_and.reduce([where[:, i(s)] for s in DERIVED[q]])
     return where
 
 

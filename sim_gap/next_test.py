@@ -66,10 +66,11 @@ import pandas as pd
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.special import logsumexp
 
-from sim_gap.candidates import FREE_FORM, LEVEL_FACTOR
+from sim_gap.candidates import FREE_FORM, LEVEL_FACTOR, level_labels
 from sim_gap.decide import set_label
 from sim_gap.evidence import OFFSET_PRIOR_SD_M, Evidence, Observations, cross_kernel
-from sim_gap.fit import MapFit, internal_bounds, quantities_of, sigmas, to_values
+from sim_gap.fit import (MapFit, independent_quantities, internal_bounds, quantities_of,
+                         sigmas, to_values)
 from sim_gap.hypotheses import OUTSIDE, param_prior
 from sim_gap.points_csv import WHEEL_KEY
 from sim_gap.simulated import Simulated
@@ -354,11 +355,7 @@ def _levels(frame: pd.DataFrame, by: str) -> np.ndarray:
     candidates": an unknown effect seen on a source is expected to persist at that source's
     new multipass or gravity levels, where the factor's own effect may add to it; the
     evidence groups by source and level, :func:`sim_gap.evidence.observations`)."""
-    if by == OUTSIDE:
-        source = frame["source"] if "source" in frame else pd.Series([""] * len(frame))
-        return source.astype(str).to_numpy()
-    return frame[by].astype(str).to_numpy() if by != "gravity_mps2" else \
-        frame[by].round(4).astype(str).to_numpy()
+    return level_labels(frame, "source" if by == OUTSIDE else by)
 
 
 def information_gain(means: list[np.ndarray], covs: list[np.ndarray], weights: np.ndarray,
@@ -426,8 +423,7 @@ def next_tests(sim: Simulated, points: pd.DataFrame, obs: Observations,
         return []
     quantities = [q for q in quantities_of(points)
                   if not (q == "sinkage_m" and points.attrs.get("sinkage_relative"))]
-    if {"resistance_n", "dp_n", "torque_nm"} <= set(quantities):
-        quantities.remove("resistance_n")  # computed from them (fit.independent_entries)
+    quantities = independent_quantities(quantities)
     ratio = _noise_ratio(points, sim.radius_m)
     models = [_Hypothesis(sim, points, obs, fits.get(h["key"], fits["soil_only"]),
                           evidence[h["key"]], _apart(h), apart_sd) for h in lead]
