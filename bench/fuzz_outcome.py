@@ -19,10 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bench.fuzz_inputs import Case
+from swtlab.pipeline.campaign import FailureKind
 from swtlab.pipeline.process import ProcessSettings, process_file
 
-#: error types that are the pipeline's own clean refusals (one line naming file and channel)
-CLEAN_ERRORS = ("IngestError",)
 TIME_LIMIT_S = 20.0
 #: quantities measured by load cells: their noise never gives a window an SE of 0 (an
 #: encoder's may hold one quantisation step)
@@ -100,7 +99,8 @@ def run_case(case: Case, time_limit_s: float = TIME_LIMIT_S) -> Outcome:
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
             signal.signal(signal.SIGALRM, previous)
-    wild = [f for f in done.failures if f.error_type not in CLEAN_ERRORS]
+    # the pipeline's own clean refusal is ingest's, one line naming file and channel
+    wild = [f for f in done.failures if f.kind is not FailureKind.REFUSED]
     if wild:
         return Outcome("unhandled", f"{wild[0].stage}: {wild[0].reason}")
     if done.result is None:

@@ -126,8 +126,7 @@ def run(args: argparse.Namespace) -> int:
         reasons = "; ".join(result.flags)
         statuses.setdefault(result.status, []).append(
             f"{result.run_id}: {reasons}" if reasons else result.run_id)
-    failed = [f.reason if f.error_type == "IngestError" else f"{f.file}: {f.stage}: {f.reason}"
-              for f in batch.failures]
+    failed = [f.line for f in batch.failures]
     done = len(batch.stored)
     print(f"processed {done} of {batch.found} runs ({batch.up_to_date} already up to date): "
           f"{len(statuses['ok'])} ok, {len(statuses['flagged'])} flagged, "

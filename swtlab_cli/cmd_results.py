@@ -60,7 +60,7 @@ def failed_rows(failures) -> pd.DataFrame:
         "run_id": f.run_id or Path(f.path).stem, "status": "failed",
         "flags": f"{f.stage} failed: {f.error}", "raw_file_path": f.path,
         "raw_file_sha256": f.sha256, "failure_stage": f.stage,
-        "failure_type": f.error_type or "IngestError", "failure_reason": f.error}
+        "failure_type": f.failure_type, "failure_reason": f.error}
         for f in failures], columns=["run_id", "status", "flags", "raw_file_path",
                                      "raw_file_sha256", "failure_stage", "failure_type",
                                      "failure_reason"])

@@ -13,6 +13,7 @@ import pytest
 
 import swtlab
 from bench.mcap_content import read_content, write_content
+from swtlab.pipeline.campaign import FailureKind
 from swtlab_cli import exit_codes
 from swtlab_cli.main import main
 
@@ -78,12 +79,16 @@ def test_the_pipeline_goes_on_after_every_kind_of_failure(folder, results_raise)
     failures = {Path(f.file).name: f for f in campaign.failures}
     assert sorted(failures) == ["a_unparseable.mcap", "b_bool_samples.mcap",
                                 "d_results_raise.mcap"]
-    assert (failures["a_unparseable.mcap"].stage, failures["a_unparseable.mcap"].error_type) \
-        == ("ingest", "IngestError")
+    refused = failures["a_unparseable.mcap"]
+    assert (refused.stage, refused.error_type, refused.kind) \
+        == ("ingest", "IngestError", FailureKind.REFUSED)
+    assert refused.line == refused.reason and refused.reason.startswith(refused.file + ": ")
     assert "JSON type bool" in failures["b_bool_samples.mcap"].reason
     raised = failures["d_results_raise.mcap"]
-    assert (raised.stage, raised.error_type, raised.reason) == (
-        "results", "ZeroDivisionError", "internal error (ZeroDivisionError: injected)")
+    assert (raised.stage, raised.error_type, raised.kind, raised.reason) == (
+        "results", "ZeroDivisionError", FailureKind.INTERNAL,
+        "internal error (ZeroDivisionError: injected)")
+    assert raised.line == f"{raised.file}: results: {raised.reason}"
     assert all("\n" not in f.reason for f in campaign.failures)
 
 

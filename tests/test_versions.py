@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 from sqlalchemy import func, select
 
+from swtlab.pipeline.campaign import FailureKind
 from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import RawFile, Run, RunResult
@@ -146,5 +147,8 @@ def test_python_store_refuses_a_claimed_run_id_as_a_failure(tmp_path, db_url, in
     assert swtlab.store(campaign, db_url) == 0
     (failure,) = campaign.failures
     assert failure.stage == "store" and failure.file == str(other)
+    # the user's input (the run id), reported on a line that names the file itself
+    assert (failure.error_type, failure.kind) == ("RunIdClaimed", FailureKind.INPUT)
+    assert failure.line == f"{other}: store: {failure.reason}"
     assert str(first) in failure.reason and "claims run_id 'r001'" in failure.reason
     assert list(swtlab.load(db_url).results["load_set_n"]) == [180.0]

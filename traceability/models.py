@@ -184,6 +184,12 @@ class IngestFailure(Base):
 
     processing: Mapped[ProcessingRecord] = relationship()
 
+    @property
+    def failure_type(self) -> str:
+        """``error_type``; a row stored before migration 0010 added the column has none and
+        was an ingest failure: ``IngestError``."""
+        return self.error_type or "IngestError"
+
 
 class StableWindow(Base):
     """The stable phase found in one raw-file version: where, how, and the checks it passed."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import Enum
 from pathlib import Path
 from typing import Any
 
@@ -12,27 +13,53 @@ from swtlab_base.domain import Wheel, check_results, wheels_of
 from swtlab_base.errors import InputError
 
 
+class FailureKind(Enum):
+    """Whose a failure is, decided where it was caught from the exception's type."""
+
+    #: ingest refused the file (an ``ingest.IngestError``): the reason is its own line
+    #: ``<file>: <channel>: <problem>``
+    REFUSED = "refused"
+    #: another :class:`~swtlab_base.errors.InputError`: the user's input, refused at a later stage
+    INPUT = "input"
+    #: any other exception: a fault of swtlab inside that run, please report it
+    INTERNAL = "internal"
+
+
 @dataclass(frozen=True)
 class Failure:
     """A run (or part of one) that could not be processed: the ``file``, the ``stage``
-    (``ingest``, ``results``, ``soil_flow``, ``store``), the one-line ``reason`` and the
-    ``error_type``, the exception's class name, kept as a record (an ``IngestError`` for a run
-    ingest refused; the reason of an error that is no :class:`~swtlab_base.errors.InputError`
-    says "internal error": a fault of swtlab inside that run, please report it)."""
+    (``ingest``, ``results``, ``soil_flow``, ``store``), the one-line ``reason``, the
+    ``error_type``, the exception's class name, kept as a record for the user, and its
+    ``kind`` (:class:`FailureKind`; None for a failure loaded from a database, which keeps
+    the class name only)."""
 
     file: str
     stage: str
     reason: str
-    error_type: str = "IngestError"
+    error_type: str
+    kind: FailureKind | None
 
     @classmethod
     def of(cls, file: str | Path, stage: str, error: BaseException) -> Failure:
         """The failure of ``stage`` on ``file`` from the exception it raised: its own message
         for an :class:`~swtlab_base.errors.InputError` (the user's input), else
         ``internal error (<type>: <message>)``, on one line."""
-        kind = type(error).__name__
-        text = str(error) if isinstance(error, InputError) else f"internal error ({kind}: {error})"
-        return cls(str(file), stage, one_line(text), kind)
+        from ingest.errors import IngestError
+
+        name = type(error).__name__
+        kind = (FailureKind.REFUSED if isinstance(error, IngestError)
+                else FailureKind.INPUT if isinstance(error, InputError) else FailureKind.INTERNAL)
+        internal = kind is FailureKind.INTERNAL
+        text = f"internal error ({name}: {error})" if internal else str(error)
+        return cls(str(file), stage, one_line(text), name, kind)
+
+    @property
+    def line(self) -> str:
+        """The failure on one line naming the file: an ingest refusal's own reason, else
+        ``<file>: <stage>: <reason>``."""
+        if self.kind is FailureKind.REFUSED:
+            return self.reason
+        return f"{self.file}: {self.stage}: {self.reason}"
 
 
 #: longest failure reason kept (a message quoting a huge value is cut, never the file name)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun, one_line
+from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
 
 
 def _content(done: ProcessedRun) -> tuple[str, int] | None:
@@ -45,7 +45,7 @@ def store_processed(session, done: ProcessedRun, parameters: dict, *,
                                              allow_run_id_reuse=allow_run_id_reuse,
                                              content=_content(done))
     except (RunIdClaimed, TextRefused) as error:
-        failure = Failure(str(done.path), "store", one_line(str(error)), type(error).__name__)
+        failure = Failure.of(done.path, "store", error)
         if failure not in done.failures:
             done.failures.append(failure)
         failed("store", done.run.run_id)
@@ -122,7 +122,7 @@ def load(db_url: str, campaign: str | None = None) -> Campaign:
 
     with open_database(db_url, read_only=True)() as session:
         table = latest_results(session)
-        failures = [Failure(row.path, row.stage, row.error, row.error_type or "IngestError")
+        failures = [Failure(row.path, row.stage, row.error, row.failure_type, None)
                     for row in current_failures(session)]
     if campaign is not None:
         if len(table) == 0 or campaign not in set(table["campaign"]):

@@ -16,7 +16,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
+from swtlab.pipeline.campaign import Campaign, Failure, FailureKind, ProcessedRun
 
 #: prctl(2) option: the signal a process gets when its parent dies (linux/prctl.h)
 PR_SET_PDEATHSIG = 1
@@ -100,7 +100,8 @@ def _soil_flow(done: ProcessedRun, settings: ProcessSettings) -> None:
     try:
         flow = run_flow(done.run, window.start_s, window.end_s, settings.max_frames)
     except FlowRunError as error:
-        done.failures.append(Failure(str(done.path), "soil_flow", error.problem, "FlowRunError"))
+        done.failures.append(Failure(str(done.path), "soil_flow", error.problem,
+                                     type(error).__name__, FailureKind.INPUT))
         return
     except Exception as error:  # one run's camera must not stop the batch
         done.failures.append(Failure.of(done.path, "soil_flow", error))
