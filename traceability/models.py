@@ -141,7 +141,7 @@ class RawFile(Base):
     size_bytes: Mapped[int] = mapped_column(Integer)
     sha256: Mapped[str] = mapped_column(String(64))
     file_format: Mapped[str] = mapped_column(String(NAME_CHARS))
-    channel_summary: Mapped[dict] = mapped_column(JSON)
+    channel_summary: Mapped[list[dict]] = mapped_column(JSON)
     problems: Mapped[list] = mapped_column(JSON)
     processing_id: Mapped[int] = mapped_column(ForeignKey("processing_record.id"))
     missing_since: Mapped[datetime | None] = mapped_column(DateTime(timezone=True),

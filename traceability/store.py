@@ -102,7 +102,7 @@ def _claimed(db_run: Run, path: str, campaign: str) -> RunIdClaimed:
         "allow_run_id_reuse=True to store this file as that run's new version")
 
 
-def store_ingested_run(session: Session, run: Any, channel_summary: dict[str, Any],
+def store_ingested_run(session: Session, run: Any, channel_summary: list[dict[str, Any]],
                        parameters: dict[str, Any], *, allow_run_id_reuse: bool = False,
                        content: tuple[str, int] | None = None) -> tuple[RawFile, StoreOutcome]:
     """Record ``run`` (an ``ingest.Run``) and its raw file; return the raw-file row and the

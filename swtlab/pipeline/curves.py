@@ -5,12 +5,21 @@ records the fits and the exports in the database the results came from (docs/fit
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
 from swtlab_base.domain import Wheel, check_results, wheels_of
 from swtlab.pipeline.campaign import Campaign
+
+if TYPE_CHECKING:
+    from sqlalchemy.orm import Session
+
+    from fitting import CurveFit
+    from traceability.models import CurveFit as StoredFit
+    from wpm_export import WheelPerformanceModule
 
 
 @dataclass
@@ -20,7 +29,7 @@ class Curves:
     curve's ``wheels`` (name -> geometry), ``inputs_sha256`` of the table, the groups
     ``not_fitted`` (too few points) and the ``options`` (degree, statuses)."""
 
-    fits: list
+    fits: list[CurveFit]
     table: pd.DataFrame
     wheels: dict[str, Wheel]
     inputs_sha256: str
@@ -28,12 +37,12 @@ class Curves:
     options: dict = field(default_factory=dict)
 
     @property
-    def flagged(self) -> list:
+    def flagged(self) -> list[CurveFit]:
         """The fits whose polynomial oscillates between its points."""
         return [f for f in self.fits if f.oscillates]
 
     def get(self, quantity: str, load_n: float, multipass: int = 0, wheel: str | None = None,
-            soil: str | None = None):
+            soil: str | None = None) -> CurveFit:
         """The one fit of ``quantity`` at set load ``load_n`` and ``multipass`` (wheel and soil
         needed only when the curves hold several)."""
         match = [f for f in self.fits if f.quantity == quantity and f.load_n == load_n
@@ -52,7 +61,7 @@ def fit_curves(campaign_or_results: Campaign | pd.DataFrame, degree: int | str =
     Groups with too few slips are left out and listed in ``not_fitted``; no usable run at all
     is a ``fitting.FittingError``. ``record_in``: the database URL the results were loaded
     from (:func:`swtlab.load`), where the fits are stored linked to their run results."""
-    from fitting import FittingError, fit_results, from_run_results
+    from fitting import FittingError, TooFewPointsError, fit_results, from_run_results
     from wpm_export import inputs_sha256
 
     results = (campaign_or_results.results if isinstance(campaign_or_results, Campaign)
@@ -61,7 +70,7 @@ def fit_curves(campaign_or_results: Campaign | pd.DataFrame, degree: int | str =
     if table.empty:
         raise FittingError(f"no usable run results (none with status in {list(statuses)}; "
                            "process the campaign first)")
-    too_few: list = []
+    too_few: list[TooFewPointsError] = []
     fits = fit_results(table, degree=degree, too_few=too_few)
     curves = Curves(fits=fits, table=table, wheels=wheels_of(table),
                     inputs_sha256=inputs_sha256(table), not_fitted=[str(e) for e in too_few],
@@ -71,7 +80,7 @@ def fit_curves(campaign_or_results: Campaign | pd.DataFrame, degree: int | str =
     return curves
 
 
-def _record(db_url: str, work) -> None:
+def _record(db_url: str, work: Callable[[Session], object]) -> None:
     """``work(session)`` in one transaction on the existing database at ``db_url``."""
     from traceability import open_database
     from traceability.database import in_transaction
@@ -79,7 +88,7 @@ def _record(db_url: str, work) -> None:
     in_transaction(open_database(db_url, create=False), work)
 
 
-def _store_fits(session, curves: Curves) -> list:
+def _store_fits(session: Session, curves: Curves) -> list[StoredFit]:
     from traceability.store_fits import store_fits
 
     if "result_id" not in curves.table:
@@ -119,7 +128,7 @@ def export_from_database(db_url: str, path: str | Path, *, degree: int | str = "
     return curves, export_wpm(curves, path, record_in=db_url)
 
 
-def read_wpm(path: str | Path):
+def read_wpm(path: str | Path) -> WheelPerformanceModule:
     """The Wheel Performance Module (``wpm_export.WheelPerformanceModule``) of a WPM CSV."""
     from wpm_export import WheelPerformanceModule
 
@@ -135,13 +144,18 @@ def query_wpm(path: str | Path, load_n: float, *, quantity: str | None = None,
     of ``quantity`` (``WheelPerformanceModule.answer_for``), or every quantity at ``slip``
     (``answer_at``), with the file and the curve set chosen (``soil``, ``wheel``,
     ``multipass``: needed only where the file holds several)."""
-    if (slip is None) == (target is None) or (target is None) != (quantity is None):
+    asked: float | tuple[str, float]
+    if slip is not None and quantity is None and target is None:
+        asked = slip
+    elif slip is None and quantity is not None and target is not None:
+        asked = (quantity, target)
+    else:
         raise ValueError("give either quantity and target, or slip")
     wpm = read_wpm(path)
     soil, wheel, multipass = wpm.select(soil=soil, wheel=wheel, multipass=multipass)
-    chosen = {"soil": soil, "wheel": wheel, "multipass": multipass,
-              "allow_extrapolation": allow_extrapolation}
-    answer = (wpm.answer_at(slip, load_n, **chosen) if slip is not None
-              else wpm.answer_for(quantity, target, load_n, **chosen))
+    chosen: dict[str, Any] = {"soil": soil, "wheel": wheel, "multipass": multipass,
+                              "allow_extrapolation": allow_extrapolation}
+    answer = (wpm.answer_for(*asked, load_n, **chosen) if isinstance(asked, tuple)
+              else wpm.answer_at(asked, load_n, **chosen))
     return {"file": str(path), "soil": soil, "wheel": wheel, "multipass": multipass,
             "load_n": load_n, **answer}

@@ -5,8 +5,12 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from swtlab.pipeline.campaign import Campaign, Failure, ProcessedRun
+
+if TYPE_CHECKING:
+    from sqlalchemy.orm import Session, sessionmaker
 
 
 def _content(done: ProcessedRun) -> tuple[str, int] | None:
@@ -14,7 +18,7 @@ def _content(done: ProcessedRun) -> tuple[str, int] | None:
     return (done.sha256, done.size_bytes) if done.sha256 and done.size_bytes is not None else None
 
 
-def store_processed(session, done: ProcessedRun, parameters: dict, *,
+def store_processed(session: Session, done: ProcessedRun, parameters: dict[str, Any], *,
                     allow_run_id_reuse: bool = False) -> bool:
     """Store one processed run in ``session`` (one transaction per run, the caller's): the
     raw file, its result, its soil flow or the failures. An unchanged file already stored
@@ -35,7 +39,7 @@ def store_processed(session, done: ProcessedRun, parameters: dict, *,
                 store_failure(session, done.path, done.sha256, f.stage, f.error_type, f.reason,
                               parameters, run_id)
 
-    if done.run is None:
+    if done.run is None or done.streams is None:  # read together: both or neither
         failed("ingest", None)
         return False
     try:
@@ -56,7 +60,7 @@ def store_processed(session, done: ProcessedRun, parameters: dict, *,
     if find_result(session, raw_file, params_sha256(parameters)):
         return False
     stored = store_run_result(session, raw_file, done.result, parameters)
-    if done.flow is not None:
+    if done.flow is not None and done.flow_npz is not None:  # measured and packed together
         store_flow(session, raw_file, stored.window, done.flow.result, done.flow_npz, parameters)
     for f in done.failures:
         if f.stage == "soil_flow":
@@ -64,7 +68,8 @@ def store_processed(session, done: ProcessedRun, parameters: dict, *,
     return True
 
 
-def store_one(session_factory, done: ProcessedRun, parameters: dict, *,
+def store_one(session_factory: sessionmaker[Session], done: ProcessedRun,
+              parameters: dict[str, Any], *,
               allow_run_id_reuse: bool = False) -> bool:
     """:func:`store_processed` in a transaction of its own (retried on a lock). A run the
     database refuses (a value it cannot hold, a constraint) is rolled back and recorded as a

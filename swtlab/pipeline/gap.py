@@ -4,10 +4,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
 from swtlab.pipeline.campaign import Campaign
+
+if TYPE_CHECKING:
+    from sim_gap.simulated import Simulated
+    from terramechanics import WheelModel
 
 
 @dataclass
@@ -50,7 +55,7 @@ class GapReport:
             write_gap_page(self.data, html_path)
 
 
-def _points(measured) -> tuple[pd.DataFrame, str]:
+def _points(measured: object) -> tuple[pd.DataFrame, str]:
     from sim_gap.measured import combine, from_results_table, load_measured
 
     if isinstance(measured, (list, tuple)):
@@ -66,7 +71,8 @@ def _points(measured) -> tuple[pd.DataFrame, str]:
     return load_measured(str(measured)), str(measured)
 
 
-def _simulated(simulation, reference_model):
+def _simulated(simulation: Simulated | WheelModel | str | Path,
+               reference_model: str | Path | None) -> tuple[Simulated, str]:
     import terramechanics as tm
     from sim_gap.simulated import Simulated, load_simulated
 
@@ -77,7 +83,9 @@ def _simulated(simulation, reference_model):
     return load_simulated(simulation, reference_model), str(simulation)
 
 
-def diagnose_gap(measured, simulation, *, effects: list[str] | None = None,
+def diagnose_gap(measured: Campaign | pd.DataFrame | str | Path | list[Any] | tuple[Any, ...],
+                 simulation: Simulated | WheelModel | str | Path, *,
+                 effects: list[str] | None = None,
                  reference_model: str | Path | None = None, n_boot: int = 200, jobs: int = 1,
                  seed: int = 0, laws: dict[str, tuple[str, ...]] | None = None,
                  allow_wheel_mismatch: bool = False,

@@ -8,10 +8,17 @@ stored, and the next call finishes it without duplicates).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from swtlab.pipeline.campaign import Failure, ProcessedRun
+
+if TYPE_CHECKING:
+    from distributed import Client
+    from sqlalchemy.orm import Session
 
 
 @dataclass
@@ -36,16 +43,19 @@ class StoredBatch:
         return sum(r.flow is not None for r in self.stored)
 
 
-def _known(session, path: Path, sha256: str | None, params_hash: str):
+def _known(session: Session, path: Path, sha256: str | None,
+           params_hash: str) -> tuple[str, list[str]] | None:
     """``(campaign, flow failure lines)`` of a file stored with this content and these
     parameters as its run's current version, else None (to be processed)."""
     from traceability.models import RawFile
     from traceability.store_flow import stored_flow_failure
     from traceability.store_results import processed_file
 
-    if sha256 is None or not processed_file(session, path, sha256, params_hash):
+    if sha256 is None:
         return None
     raw_file = session.query(RawFile).filter_by(path=str(path.resolve()), sha256=sha256).first()
+    if raw_file is None or not processed_file(session, path, sha256, params_hash):
+        return None
     failure = stored_flow_failure(session, path, sha256, params_hash)
     return (raw_file.run.campaign.name,
             [] if failure is None else [f"{path}: {failure.channel}: {failure.problem}"])
@@ -53,8 +63,9 @@ def _known(session, path: Path, sha256: str | None, params_hash: str):
 
 def process_into(db_url: str, folder: str | Path, channel_map: str | None = None,
                  jobs: int = 1, *, rig_compliance_file: str | Path | None = None,
-                 allow_run_id_reuse: bool = False, client=None,
-                 progress=None) -> StoredBatch:
+                 allow_run_id_reuse: bool = False, client: Client | None = None,
+                 progress: Callable[..., Iterable[ProcessedRun]] | None = None
+                 ) -> StoredBatch:
     """Process every run under ``folder`` into the database at ``db_url`` (created or
     upgraded) and mark stored files gone from ``folder`` missing.
 
@@ -98,8 +109,8 @@ def process_into(db_url: str, folder: str | Path, channel_map: str | None = None
             content = content_sha256(path)
         except OSError:
             content = None  # unreadable: process_file records why
-        known = in_transaction(session_factory, lambda session, p=path, c=content: _known(
-            session, p, c and c[0], params_hash))
+        known = in_transaction(session_factory, partial(
+            _known, path=path, sha256=content and content[0], params_hash=params_hash))
         if known is None:
             todo.append((path, content))
         else:
@@ -134,7 +145,7 @@ def process_into(db_url: str, folder: str | Path, channel_map: str | None = None
                                              client=client, contents=[c for _, c in again],
                                              keep_samples=False) if r.result is not None]
     if pooled:
-        def store_pooled(session):
+        def store_pooled(session: Session) -> None:
             for done, result in zip(pooled, pool_drift([r.result for r in pooled])):
                 replace_uncertainty(session, done.path, done.sha256, params_hash,
                                     result.uncertainty)

@@ -10,18 +10,44 @@ import os
 import signal
 import sys
 import tomllib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from swtlab.pipeline.campaign import Campaign, Failure, FailureKind, ProcessedRun
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+    from run_results import RigCompliance
+    from run_results.uncertainty_budget import BudgetParams
+    from stable_phase import StablePhaseParams
 
 #: prctl(2) option: the signal a process gets when its parent dies (linux/prctl.h)
 PR_SET_PDEATHSIG = 1
 #: the campaign's settings file (``[rig_compliance]``, ``[uncertainty]``, docs/run-results.md)
 CAMPAIGN_SETTINGS = "swtlab.toml"
+
+
+def _stable_default() -> StablePhaseParams:
+    from stable_phase import StablePhaseParams
+
+    return StablePhaseParams()
+
+
+def _max_frames_default() -> int:
+    from softflow.flow_run import MAX_FRAMES
+
+    return MAX_FRAMES
+
+
+def _budget_default() -> BudgetParams:
+    from run_results.uncertainty_budget import BudgetParams
+
+    return BudgetParams()
 
 
 @dataclass(frozen=True)
@@ -31,22 +57,10 @@ class ProcessSettings:
     uncertainty budget is told (``run_results.uncertainty_budget.BudgetParams``)."""
 
     channel_map: str | None = None
-    rig: object = None
-    stable: object = None
-    max_frames: int | None = None
-    budget: object = None
-
-    def __post_init__(self) -> None:
-        from run_results.uncertainty_budget import BudgetParams
-        from softflow.flow_run import MAX_FRAMES
-        from stable_phase import StablePhaseParams
-
-        if self.budget is None:
-            object.__setattr__(self, "budget", BudgetParams())
-        if self.stable is None:
-            object.__setattr__(self, "stable", StablePhaseParams())
-        if self.max_frames is None:
-            object.__setattr__(self, "max_frames", MAX_FRAMES)
+    rig: RigCompliance | None = None
+    stable: StablePhaseParams = field(default_factory=_stable_default)
+    max_frames: int = field(default_factory=_max_frames_default)
+    budget: BudgetParams = field(default_factory=_budget_default)
 
     def parameters(self) -> dict:
         """The parameters recorded with (and hashed into) every stored result."""
@@ -56,7 +70,7 @@ class ProcessSettings:
                 "uncertainty": self.budget.to_dict()}
 
 
-def rig_compliance(folder: Path, path: Path | None = None):
+def rig_compliance(folder: Path, path: str | Path | None = None) -> RigCompliance | None:
     """The ``[rig_compliance]`` of ``path``, else of ``folder/swtlab.toml``; None when neither
     file exists or the campaign's file has no such table (it may hold ``[uncertainty]``
     alone). A named file that is missing, or without the table, is an error."""
@@ -75,7 +89,7 @@ def rig_compliance(folder: Path, path: Path | None = None):
     return RigCompliance.from_dict(table)
 
 
-def budget_params(folder: Path):
+def budget_params(folder: Path) -> BudgetParams:
     """The ``[uncertainty]`` of ``folder/swtlab.toml`` (``clock_rate_bound_ppm``: the loggers'
     stated clock tolerance; ``zero_age_s``, ``zero_age_min_s``: the longest and shortest time
     from zeroing the load cells to a run's start) as ``BudgetParams``; nothing stated without
@@ -199,7 +213,8 @@ def _process(path: Path, settings: ProcessSettings, content: tuple[str, int] | N
 
 
 def process_files(paths: list[Path], settings: ProcessSettings, jobs: int = 1, *,
-                  client=None, contents: list | None = None,
+                  client: Client | None = None,
+                  contents: list[tuple[str, int] | None] | None = None,
                   keep_samples: bool = True) -> Iterator[ProcessedRun]:
     """:func:`process_file` of each of ``paths``, yielded in their order as they are done:
     in this process (``jobs`` 1), on ``jobs`` worker processes (:func:`worker_pool`: each
@@ -263,7 +278,9 @@ def _name(path: Path) -> str:
 def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: int = 1, *,
                      rig_compliance_file: str | Path | None = None,
                      runs: list[str] | None = None, soil_flow: bool = True,
-                     progress=None, client=None, keep_samples: bool = True) -> Campaign:
+                     progress: Callable[[Iterator[ProcessedRun]], Iterable[ProcessedRun]]
+                     | None = None, client: Client | None = None,
+                     keep_samples: bool = True) -> Campaign:
     """Every run under ``folder`` -> :class:`Campaign`, without a database.
 
     ``channel_map``: TOML map (path or shipped name) for a lab's own files; ``jobs`` > 1 runs
@@ -278,6 +295,8 @@ def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: i
     over every run processed (under ``folder``, or those of ``runs``) with a result, per
     campaign (:func:`campaign_of`); :func:`swtlab.process_into` pools it the same way.
     """
+    from softflow.flow_run import MAX_FRAMES
+
     if jobs < 1:
         raise ValueError(f"jobs {jobs} must be >= 1")
     paths = find_runs(folder, channel_map)
@@ -288,7 +307,7 @@ def process_campaign(folder: str | Path, channel_map: str | None = None, jobs: i
         paths = [p for p in paths if _name(p) in set(runs)]
     settings = ProcessSettings(channel_map=channel_map,
                                rig=rig_compliance(Path(folder), rig_compliance_file),
-                               max_frames=None if soil_flow else 0,
+                               max_frames=MAX_FRAMES if soil_flow else 0,
                                budget=budget_params(Path(folder)))
     done = process_files(paths, settings, jobs, client=client, keep_samples=keep_samples)
     return campaign_of(list(progress(done) if progress else done), settings.parameters())
