@@ -41,9 +41,9 @@ VARIANTS = ("with_term", "without_term")
 
 
 def _campaign(seed: int):
-    conds = [RunCondition(f"r{int(w)}_{i}", "speed_control", w, 0, s)
+    conds = [RunCondition.of(f"r{int(w)}_{i}", "speed_control", w, 0, s)
              for w in TESTED_N for i, s in enumerate(SLIPS)]
-    conds += [RunCondition(f"h{int(HELD_OUT_N)}_{i}", "speed_control", HELD_OUT_N, 0, s)
+    conds += [RunCondition.of(f"h{int(HELD_OUT_N)}_{i}", "speed_control", HELD_OUT_N, 0, s)
               for i, s in enumerate(HELD_OUT_SLIPS)]
     with tempfile.TemporaryDirectory() as tmp:
         generate_campaign(tmp, conds, seed=seed, rates=SAMPLE_RATES, form="csv",

@@ -38,10 +38,10 @@ def _campaign(n_runs: int, form: str) -> list[Path]:
     marker = folder / "complete"
     if not marker.exists():
         rng = np.random.default_rng(SEED)
-        conditions = [RunCondition(run_id=f"bench_{i:03d}", mode="speed_control",
-                                   load_n=float(rng.choice([70.0, 180.0, 300.0])),
-                                   multipass=int(rng.integers(0, 2)),
-                                   slip_setpoint=float(rng.uniform(-0.1, 0.7)))
+        conditions = [RunCondition.of(run_id=f"bench_{i:03d}", mode="speed_control",
+                                      load_set_n=float(rng.choice([70.0, 180.0, 300.0])),
+                                      multipass=int(rng.integers(0, 2)),
+                                      slip_setpoint=float(rng.uniform(-0.1, 0.7)))
                       for i in range(n_runs)]
         rates = Rates(*(RATE_HZ,) * 6)
         print(f"writing {n_runs} {form} runs at {RATE_HZ:.0f} Hz into {folder} (once)")

@@ -58,7 +58,7 @@ def write_points(model: tm.WheelModel, path: Path) -> None:
 
     conds = conditions(Design())
     load, slip, mp, g = (np.array([getattr(c, a) for c in conds], float) for a in
-                         ("load_n", "slip_setpoint", "multipass", "gravity_mps2"))
+                         ("load_set_n", "slip_setpoint", "multipass", "gravity_mps2"))
     with open(path, "w", newline="") as f:
         out = csv.writer(f)
         out.writerow(HEADER)

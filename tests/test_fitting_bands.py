@@ -96,9 +96,9 @@ def virtual_campaigns(tmp_path_factory):
 
     out = []
     for seed in (21, 22):
-        conds = [RunCondition(f"r{int(w)}_{i}", "speed_control", w, 0, s)
+        conds = [RunCondition.of(f"r{int(w)}_{i}", "speed_control", w, 0, s)
                  for w in (70.0, 180.0, 300.0) for i, s in enumerate(SLIPS)]
-        conds += [RunCondition(f"h{int(w)}_{i}", "speed_control", w, 0, s)
+        conds += [RunCondition.of(f"h{int(w)}_{i}", "speed_control", w, 0, s)
                   for w, slips in HELD_OUT.items() for i, s in enumerate(slips)]
         folder = tmp_path_factory.mktemp(f"bands{seed}")
         generate_campaign(folder, conds, seed=seed, rates=SAMPLE_RATES, form="csv",

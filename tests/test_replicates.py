@@ -55,9 +55,9 @@ def test_a_campaign_without_replicates_says_so():
 def replicated(tmp_path_factory):
     """Six replicates each of two conditions on the virtual testbed (CSV, short runs)."""
     out = tmp_path_factory.mktemp("replicates")
-    conds = [RunCondition(f"a{i}", "speed_control", 180.0, 0, 0.3) for i in range(6)]
-    conds += [RunCondition(f"b{i}", "speed_control", 120.0, 1, 0.1) for i in range(6)]
-    conds += [RunCondition("c0", "towed", 250.0, 0)]
+    conds = [RunCondition.of(f"a{i}", "speed_control", 180.0, 0, 0.3) for i in range(6)]
+    conds += [RunCondition.of(f"b{i}", "speed_control", 120.0, 1, 0.1) for i in range(6)]
+    conds += [RunCondition.of("c0", "towed", 250.0, 0)]
     generate_campaign(out, conds, seed=61, rates=SAMPLE_RATES, form="csv")
     return out / "campaign"
 

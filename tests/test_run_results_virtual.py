@@ -199,9 +199,9 @@ def test_rig_compliance_shifts_hub_height_and_sinkage(processed):
 
 def test_towed_resistance_against_powered_runs_near_zero_slip(tmp_path):
     """BB2 testbed law at 180 N: R about 18 N at multipass 0, less on compacted soil."""
-    conditions = [RunCondition(f"L180_MP{mp}_SC{i}", "speed_control", 180.0, mp, s)
+    conditions = [RunCondition.of(f"L180_MP{mp}_SC{i}", "speed_control", 180.0, mp, s)
                   for mp in (0, 1, 2) for i, s in enumerate((-0.1, -0.05, 0.0, 0.05, 0.1))]
-    conditions += [RunCondition(f"L180_MP{mp}_TW", "towed", 180.0, mp) for mp in (0, 1, 2)]
+    conditions += [RunCondition.of(f"L180_MP{mp}_TW", "towed", 180.0, mp) for mp in (0, 1, 2)]
     generate_campaign(tmp_path, conditions, seed=5, rates=RATES)
     results, truths = [], {}
     for c in conditions:
@@ -225,7 +225,7 @@ def test_towed_resistance_against_powered_runs_near_zero_slip(tmp_path):
 
 def test_steered_run_reports_side_force_and_slip_angle(tmp_path):
     """A steered testbed run (10 deg slip angle): side force and slip angle against the truth."""
-    condition = RunCondition("ST10", "steered", 180.0, 0, 0.2, steer_deg=10.0)
+    condition = RunCondition.of("ST10", "steered", 180.0, 0, 0.2, steer_deg=10.0)
     generate_campaign(tmp_path, [condition], seed=3, rates=RATES)
     truth = json.loads((tmp_path / "truth" / "ST10.json").read_text())
     result = process_run(ingest.read_run(tmp_path / truth["raw_file"]))

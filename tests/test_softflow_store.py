@@ -32,8 +32,8 @@ pytestmark = pytest.mark.slow  # a filmed campaign generated, processed: flow on
 
 RATES = Rates(40.0, 40.0, 20.0, 20.0, 10.0, 10.0)
 FILMED = {"FLOW_MCAP": "mcap", "FLOW_CSV": "csv"}
-CONDITIONS = [RunCondition("FLOW_MCAP", "speed_control", 180.0, 0, 0.3, side_camera_frames=6),
-              RunCondition("FLOW_CSV", "speed_control", 120.0, 0, 0.15, side_camera_frames=6)]
+CONDITIONS = [RunCondition.of("FLOW_MCAP", "speed_control", 180.0, 0, 0.3, side_camera_frames=6),
+              RunCondition.of("FLOW_CSV", "speed_control", 120.0, 0, 0.15, side_camera_frames=6)]
 #: Tolerances against the render truth, in the contact region (beta -160..-20 deg) where the
 #: component's rim velocity is at least 30 % of the travel velocity (elsewhere the rate is
 #: undefined) and the fit has R2 >= MIN_R2. Measured on these runs with seeds 5, 6, 7 (committed

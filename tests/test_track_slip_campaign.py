@@ -19,9 +19,9 @@ RATES = Rates(40.0, 40.0, 20.0, 20.0, 10.0, 10.0)
 @pytest.mark.slow  # a five-run campaign with track photos generated, processed and reported
 def test_image_slip_beside_encoder_slip(tmp_path, capsys):
     slips = (0.05, 0.2, 0.4, 0.7)
-    conditions = [RunCondition(f"P{i}", "speed_control", 180.0, 0, s, track_photos=2)
+    conditions = [RunCondition.of(f"P{i}", "speed_control", 180.0, 0, s, track_photos=2)
                   for i, s in enumerate(slips)]
-    conditions.append(RunCondition("NOPHOTO", "speed_control", 180.0, 0, 0.3))
+    conditions.append(RunCondition.of("NOPHOTO", "speed_control", 180.0, 0, 0.3))
     forms = {c.run_id: ("csv" if c.run_id == "P1" else "mcap") for c in conditions}
     generate_campaign(tmp_path, conditions, seed=21, rates=RATES, form=forms)
     db = f"sqlite:///{tmp_path / 'db.sqlite'}"

@@ -19,7 +19,7 @@ LAW, TL, DYN = bb2_sand_law(), Timeline(), Dynamics()
 
 
 def _run(mode="speed_control", load=180.0, slip=0.3, multipass=0):
-    cond = RunCondition("x", mode, load, multipass, slip if mode == "speed_control" else None)
+    cond = RunCondition.of("x", mode, load, multipass, slip if mode == "speed_control" else None)
     return simulate_true_run(cond, LAW, BB2_WHEEL, TL, DYN)
 
 
@@ -118,7 +118,7 @@ def test_smooth_wheel_has_no_grouser_oscillation():
     """A smooth rim (no grousers): the run simulates, DP and torque follow the steady law
     without the passing oscillation, no grousers in contact."""
     smooth = replace(BB2_WHEEL, grouser_count=0, grouser_height_m=0.0)
-    cond = RunCondition("x", "speed_control", 180.0, 0, 0.3)
+    cond = RunCondition.of("x", "speed_control", 180.0, 0, 0.3)
     run = simulate_true_run(cond, LAW, smooth, TL, DYN)
     t = run.signals["t_s"]
     window = (t > TL.window_start_s) & (t < TL.decel_start_s)

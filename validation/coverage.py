@@ -66,8 +66,8 @@ def write_virtual(out: Path, n: int, seed: int, duration_s: float = 60.0) -> dic
     """A virtual-testbed campaign in ``out/campaign`` (CSV runs); returns the truths."""
     conds = []
     for i, kind, load, mp, slip in _draws(n, seed, (60.0, 320.0)):
-        conds.append(RunCondition(f"{kind[:2]}{i:03d}", kind, load, mp,
-                                  slip if kind == "speed_control" else None))
+        conds.append(RunCondition.of(f"{kind[:2]}{i:03d}", kind, load, mp,
+                                     slip if kind == "speed_control" else None))
     generate_campaign(out, conds, seed=seed, rates=SAMPLE_RATES, form="csv",
                       duration_s=duration_s)
     _settings(out / "campaign", VirtualSensors().clock_rate_error_ppm, (0.0, 0.0))
@@ -79,7 +79,7 @@ def write_virtual(out: Path, n: int, seed: int, duration_s: float = 60.0) -> dic
         law, means = t["law_steady"], t["stable_means"]
         truths[c.run_id] = {**{k: law[k] for k in ("dp_n", "torque_nm", "thrust_n",
                                                    "resistance_n", "sinkage_m", "slip")},
-                            "wheel_load_n": c.load_n,
+                            "wheel_load_n": c.load_set_n,
                             **{k: means[k] for k in ("travel_velocity_mps",
                                                      "wheel_omega_radps")}}
     return truths

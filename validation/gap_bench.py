@@ -175,8 +175,8 @@ def conditions(design: Design):
         for mp in design.multipass:
             for load in design.loads_n:
                 for s in design.slips:
-                    out.append(RunCondition(f"r{len(out):03d}", "speed_control", load, mp, s,
-                                            gravity_mps2=g))
+                    out.append(RunCondition.of(f"r{len(out):03d}", "speed_control", load, mp, s,
+                                               gravity_mps2=g))
     return out
 
 

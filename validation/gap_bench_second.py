@@ -25,8 +25,8 @@ def rig_conditions(conds, campaign: str, w) -> list[RunCondition]:
     wheel = WheelGeometry(name=w.name, radius_m=w.radius_m, width_m=w.width_m,
                           grouser_count=w.grouser_count, grouser_height_m=w.grouser_height_m,
                           stiffness_n_per_mm=w.stiffness_n_per_mm)
-    return [RunCondition(c.run_id, c.mode, c.load_n, c.slip_setpoint, multipass=c.multipass,
-                         gravity_mps2=c.gravity_mps2, velocity_mps=c.velocity_mps, soil="sand",
+    return [RunCondition(c.run_id, c.mode, c.load_set_n, c.slip_setpoint, multipass=c.multipass,
+                         gravity_mps2=c.gravity_mps2, velocity_mps=c.velocity_set_mps, soil="sand",
                          campaign=campaign, wheel=wheel)
             for c in conds]
 

@@ -64,12 +64,12 @@ def run_metadata(condition: RunCondition, testbed: Testbed, start: str) -> dict[
     """The spec's ``swt.run``, ``swt.wheel`` and ``swt.suspension`` records (typed values)."""
     c, w = condition, testbed.wheel
     run = {"run_id": c.run_id, "campaign": testbed.campaign, "wheel": w.name, "soil": testbed.soil,
-           "multipass": c.multipass, "mode": c.mode, "load_N": float(c.load_n)}
+           "multipass": c.multipass, "mode": c.mode, "load_N": float(c.load_set_n)}
     if c.slip_setpoint is not None:
         run["slip_setpoint"] = float(c.slip_setpoint)
     if c.steer_deg is not None:
         run["steer_deg"] = float(c.steer_deg)
-    run.update({"velocity_mps": float(c.velocity_mps), "gravity_mps2": float(c.gravity_mps2),
+    run.update({"velocity_mps": float(c.velocity_set_mps), "gravity_mps2": float(c.gravity_mps2),
                 "started_at": start})
     wheel = {"radius_m": w.radius_m, "width_m": w.width_m, "grouser_count": w.grouser_count,
              "grouser_height_m": w.grouser_height_m}

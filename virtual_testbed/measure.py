@@ -146,7 +146,7 @@ def measure(true_run: TrueRun, wheel: Wheel, suspension: Suspension, rates: sn.R
     tl, c = true_run.timeline, true_run.condition
     ctx = _Sensing(true_run, wheel, suspension, sensors, rng, zero=_zero_offsets(rng, sensors),
                    calibration=_dp_calibration(rng, sensors),
-                   spikes=sn.gravel_spikes(tl.motion_start_s, tl.decel_start_s, c.load_n,
+                   spikes=sn.gravel_spikes(tl.motion_start_s, tl.decel_start_s, c.load_set_n,
                                            wheel.radius_m, rng, sensors))
     topics = [t for t in _CHANNELS if not (t == "/tether/encoder" and c.mode == "free_sled")]
     channels, blocks, clocks = {}, {}, {}

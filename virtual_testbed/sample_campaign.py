@@ -55,16 +55,16 @@ def sample_conditions() -> list[tuple[RunCondition, str]]:
     runs = []
     for load in LOADS_N:
         for mp in MULTIPASSES:
-            runs += [(RunCondition(run_id(load, mp, "speed_control", s), "speed_control", load,
-                                   mp, s, track_photos=int((load, mp, s) in PHOTOGRAPHED)),
+            runs += [(RunCondition.of(run_id(load, mp, "speed_control", s), "speed_control", load,
+                                      mp, s, track_photos=int((load, mp, s) in PHOTOGRAPHED)),
                       "mcap") for s in SLIPS]
-    runs += [(RunCondition(run_id(VALIDATION_LOAD_N, 0, "speed_control", s), "speed_control",
-                           VALIDATION_LOAD_N, 0, s), "mcap") for s in VALIDATION_SLIPS]
+    runs += [(RunCondition.of(run_id(VALIDATION_LOAD_N, 0, "speed_control", s), "speed_control",
+                              VALIDATION_LOAD_N, 0, s), "mcap") for s in VALIDATION_SLIPS]
     for load in LOADS_N:
-        runs += [(RunCondition(run_id(load, 0, mode), mode, load, 0), "csv")
+        runs += [(RunCondition.of(run_id(load, 0, mode), mode, load, 0), "csv")
                  for mode in ("towed", "free_sled")]
-    runs.append((RunCondition(run_id(180.0, 0, "steered", 0.2) + "_b10", "steered", 180.0, 0, 0.2,
-                              steer_deg=10.0), "mcap"))
+    runs.append((RunCondition.of(run_id(180.0, 0, "steered", 0.2) + "_b10", "steered", 180.0, 0,
+                                 0.2, steer_deg=10.0), "mcap"))
     return [(replace(c, side_camera_frames=SIDE_CAMERA_FRAMES) if c.run_id in FILMED else c, form)
             for c, form in runs]
 

@@ -71,7 +71,7 @@ def steady_slip(condition: RunCondition, law: PerformanceLaw) -> float:
     if condition.mode in SLIP_IMPOSED:
         return float(condition.slip_setpoint)
     solver = self_propelled_slip if condition.mode == "free_sled" else towed_slip
-    return solver(law, condition.load_n, condition.multipass, condition.gravity_mps2)
+    return solver(law, condition.load_set_n, condition.multipass, condition.gravity_mps2)
 
 
 def surface_speed_mps(velocity_mps, slip):
@@ -102,10 +102,10 @@ def _kinematics(c: RunCondition, slip_ss: float, speed, settle, radius_m: float,
     """
     if c.mode == "free_sled":
         slip = slip_ss + (dyn.free_sled_start_slip_ratio - 1.0) * slip_ss * settle
-        omega = surface_speed_mps(c.velocity_mps, slip_ss) / radius_m * speed
+        omega = surface_speed_mps(c.velocity_set_mps, slip_ss) / radius_m * speed
         return slip, travel_speed_mps(omega * radius_m, slip), omega
     slip = np.full_like(speed, slip_ss)
-    velocity = c.velocity_mps * speed
+    velocity = c.velocity_set_mps * speed
     return slip, velocity, surface_speed_mps(velocity, slip) / radius_m
 
 
@@ -120,10 +120,10 @@ def simulate_true_run(condition: RunCondition, law: PerformanceLaw, wheel: Wheel
     t = np.arange(int(round(tl.duration_s * dyn.grid_hz)) + 1) / dyn.grid_hz
     slip_ss = steady_slip(c, law)
     law_ss = {k: float(v) for k, v in
-              law.evaluate(c.load_n, slip_ss, c.multipass, c.gravity_mps2).items()}
+              law.evaluate(c.load_set_n, slip_ss, c.multipass, c.gravity_mps2).items()}
     z_ss = law_ss["sinkage_m"]
     z_start = dyn.static_sinkage_ratio * float(
-        law.evaluate(c.load_n, 0.0, c.multipass, c.gravity_mps2)["sinkage_m"])
+        law.evaluate(c.load_set_n, 0.0, c.multipass, c.gravity_mps2)["sinkage_m"])
 
     moving = t > tl.motion_start_s
     since_start = np.where(moving, t - tl.motion_start_s, 0.0)
@@ -136,7 +136,7 @@ def simulate_true_run(condition: RunCondition, law: PerformanceLaw, wheel: Wheel
     wheel_angle = cumulative_trapezoid(omega, t, initial=0.0)
     sled_position = cumulative_trapezoid(velocity, t, initial=0.0)
 
-    dig_in_slip = dyn.dig_in_slip(c.load_n, c.multipass)
+    dig_in_slip = dyn.dig_in_slip(c.load_set_n, c.multipass)
     digs_in = c.mode in SLIP_IMPOSED and slip_ss >= dig_in_slip
     dig_start_s = tl.motion_start_s + dyn.dig_delay_s
     dig_s = np.clip(np.minimum(t, tl.decel_start_s) - dig_start_s, 0.0, None)
@@ -155,7 +155,7 @@ def simulate_true_run(condition: RunCondition, law: PerformanceLaw, wheel: Wheel
     else:  # a smooth rim: no grouser passing oscillation
         in_contact, osc = 0.0, np.zeros_like(t)
         osc_fz = osc
-    w = c.load_n
+    w = c.load_set_n
     fx = thrust - resistance + dyn.dp_oscillation_ratio * w * osc
     signals = {
         "t_s": t,

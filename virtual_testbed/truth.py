@@ -64,7 +64,7 @@ def truth_record(true_run: TrueRun, *, radius_m: float, grouser_count: int, raw_
     if true_run.digs_in:
         window, means = None, None
         reason = (f"dig-in: slip {c.slip_setpoint:.2f} >= {true_run.dig_in_slip:.3f} at "
-                  f"{c.load_n:g} N, multipass {c.multipass}: sinkage grows without bound, "
+                  f"{c.load_set_n:g} N, multipass {c.multipass}: sinkage grows without bound, "
                   "drawbar pull rises then collapses")
         omega = float(true_run.signals["omega_radps"].max())
     else:
@@ -77,7 +77,7 @@ def truth_record(true_run: TrueRun, *, radius_m: float, grouser_count: int, raw_
         "raw_file": raw_file,
         "form": form,
         "seed": seed,
-        "condition": asdict(c),
+        "condition": c.to_dict(),
         "stable_window": window,
         "no_stable_phase_reason": reason,
         "stable_means": means,
