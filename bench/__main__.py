@@ -3,7 +3,9 @@
 Each ``bench/bench_<name>.py`` has ``main(quick: bool) -> dict`` that prints
 its own table and returns its numbers; the numbers of a run are written to
 ``bench/results/<name>.json`` for comparison between commits. ``--markdown``: a benchmark
-with ``markdown(numbers) -> str`` also writes ``docs/validation/<name>.md``.
+with ``markdown(numbers) -> str`` also writes ``docs/validation/<name>.md``, under its title
+the line naming the release and the command (:func:`provenance`, which
+tests/test_validation_records.py reads).
 """
 
 from __future__ import annotations
@@ -12,10 +14,27 @@ import argparse
 import importlib
 import json
 import pkgutil
+import tomllib
 from pathlib import Path
 
 import bench
 from swtlab_base.atomic import write_atomically
+
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def provenance(name: str) -> str:
+    """The line a page written by ``--markdown`` carries: the release of the checkout the
+    bench ran on (pyproject.toml's version) and the command that wrote it."""
+    release = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    return f"From release {release}: `python -m bench {name} --markdown`"
+
+
+def page(name: str, markdown: str) -> str:
+    """``markdown`` (a benchmark's page) with :func:`provenance` under its title line."""
+    title, _, rest = markdown.partition("\n")
+    return f"{title}\n\n{provenance(name)}\n{rest}"
 
 
 def main() -> None:
@@ -38,10 +57,10 @@ def main() -> None:
         numbers = module.main(quick=args.quick)
         (out / f"{name}.json").write_text(json.dumps(numbers, indent=2, default=float))
         if args.markdown and hasattr(module, "markdown"):
-            page = Path(__file__).parents[1] / "docs" / "validation" / f"{name}.md"
-            page.parent.mkdir(exist_ok=True)
-            write_atomically(page, module.markdown(numbers))
-            print(f"written {page}")
+            path = ROOT / "docs" / "validation" / f"{name}.md"
+            path.parent.mkdir(exist_ok=True)
+            write_atomically(path, page(name, module.markdown(numbers)))
+            print(f"written {path}")
 
 
 if __name__ == "__main__":
