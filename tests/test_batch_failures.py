@@ -195,3 +195,11 @@ def test_plain_text_escapes_every_dollar():
     png, _ = to_png(fig)
     assert png[:4] == b"\x89PNG" and plain_text("a $b$") == r"a \$b\$"
     assert np.isfinite(len(png))
+
+
+def test_a_failure_stored_before_its_type_was_recorded_reads_as_an_ingest_error():
+    # migration 0010 added error_type; the rows before it were ingest failures
+    from traceability.models import IngestFailure
+
+    assert IngestFailure(error_type=None).failure_type == "IngestError"
+    assert IngestFailure(error_type="RunIdClaimed").failure_type == "RunIdClaimed"
