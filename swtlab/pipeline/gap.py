@@ -4,10 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from swtlab.pipeline.campaign import Campaign
+
+if TYPE_CHECKING:
+    from sim_gap import report_types
 
 
 @dataclass
@@ -37,6 +41,13 @@ class GapReport:
     def to_dict(self) -> dict:
         return self.data
 
+    @property
+    def typed(self) -> report_types.GapReport:
+        """The report as typed objects (:class:`sim_gap.report_types.GapReport`)."""
+        from sim_gap.report_types import GapReport as Typed
+
+        return Typed.from_json(self.data)
+
     def write(self, json_path: str | Path | None = None,
               html_path: str | Path | None = None) -> None:
         """Write the JSON and the self-contained HTML page (the campaign report's gap
@@ -47,7 +58,7 @@ class GapReport:
         if json_path:
             write_json(self.data, json_path)
         if html_path:
-            write_gap_page(self.data, html_path)
+            write_gap_page(self.typed, html_path)
 
 
 def _points(measured) -> tuple[pd.DataFrame, str]:
