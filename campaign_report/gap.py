@@ -33,11 +33,11 @@ from campaign_report.figures import (condition_text, gap_curves, gap_heatmap,
                                      varying_factors)
 from campaign_report.html import Block, Heading, Image, Note, Page, Section, Table, render_page
 from campaign_report.images import to_png
-from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, value_text
+from campaign_report.style import EFFECTS, PARAMETERS, QUANTITIES, Palette, Quantity, value_text
 from sim_gap.hypotheses import OUTSIDE
 from sim_gap.report import READABLE_SCHEMAS
-from sim_gap.report_types import (SOIL_ONLY, Explained, GapReport, Hypothesis, Law,
-                                  SiblingContrast, UnknownSchema)
+from sim_gap.report_types import (SOIL_ONLY, Explained, GapReport, HeldOutReport, Hypothesis,
+                                  Law, PosteriorReport, SiblingContrast, UnknownSchema)
 from sim_gap.vocabulary import slip_band_labels
 from swtlab_base.atomic import write_atomically
 from swtlab_base.rounding import to_decimal_of
@@ -154,7 +154,7 @@ def _region_text(report: GapReport, where: Mapping[str, Any]) -> str | None:
             f" (z = {region['z_soil_recalibrated']:.1f}).")
 
 
-def next_tests_text(report: GapReport) -> str | None:
+def next_tests_text(report: PosteriorReport) -> str | None:
     """Schema 2, inconclusive: the tests that would tell most about which explanation is
     right, by their expected information gain (``next_tests``, at most three)."""
     tests = report.next_tests
@@ -167,7 +167,7 @@ def next_tests_text(report: GapReport) -> str | None:
             + "; ".join(parts) + ".")
 
 
-def _entropy_bits(report: GapReport) -> float:
+def _entropy_bits(report: PosteriorReport) -> float:
     """The entropy of the effect sets' probabilities, in bits: what a test could tell."""
     p = [s.probability for s in report.effect_sets if s.probability > 0]
     return -sum(x * math.log2(x) for x in p)
@@ -181,7 +181,8 @@ def decisive_test_text(report: GapReport) -> str | None:
         return None
     if test.get("region"):  # schema 2: only for a verdict outside the candidates
         return (_region_text(report, test["region"])
-                if not report.schema2 or report.verdict == OUTSIDE else None)
+                if not isinstance(report, PosteriorReport) or report.verdict == OUTSIDE
+                else None)
     leaders = report.leading()
     who = (" and ".join(candidate_text(x) for x in leaders) if len(leaders) == 2
            else "the two leading explanations")
@@ -229,7 +230,7 @@ def significant_regions(regions: Sequence[Mapping[str, Any]], tag: str) -> list[
     for r in regions:
         if r[f"significant{tag}"]:
             strongest[_key(r)] = max(strongest.get(_key(r), 0.0), abs(r[f"z{tag}"]))
-    return sorted(strongest, key=strongest.get, reverse=True)[:REGIONS_SHOWN]
+    return sorted(strongest, key=lambda k: strongest[k], reverse=True)[:REGIONS_SHOWN]
 
 
 def _regions_table(report: GapReport, tag: str) -> Table | None:
@@ -291,7 +292,7 @@ def _where_blocks(report: GapReport) -> list[Block]:
     return blocks
 
 
-def _which_blocks_schema1(report: GapReport) -> list[Block]:
+def _which_blocks_schema1(report: HeldOutReport) -> list[Block]:
     rows = [[str(i + 1), candidate_text(c), f"{c.held_out_score:.3g}", f"{c.z_vs_best:.3g}",
              str(c.n_params), _parameters_text(c.parameters)]
             for i, c in enumerate(report.candidates[:CANDIDATES_SHOWN])]
@@ -356,7 +357,7 @@ def _per_band_blocks(report: GapReport, keys: list[str]) -> list[Block]:
                   numeric=frozenset(range(1, len(keys) + 1)))]
 
 
-def _number(quantity, si_value: float | None) -> str:
+def _number(quantity: Quantity, si_value: float | None) -> str:
     return "" if si_value is None else f"{si_value * quantity.scale:.3g}"
 
 
@@ -388,7 +389,7 @@ def _folds_text(folds: Sequence[str]) -> str:
 # --- schema 2: posterior probabilities -------------------------------------------------
 
 
-def _verdict_blocks(report: GapReport) -> list[Block]:
+def _verdict_blocks(report: PosteriorReport) -> list[Block]:
     """The verdict with its probability, the rule, the leaders when inconclusive, the
     report's reason as written and the next test."""
     verdict, call = report.verdict, report.call_probability
@@ -409,10 +410,10 @@ def _verdict_blocks(report: GapReport) -> list[Block]:
     return blocks
 
 
-def _noise_note(report: GapReport) -> list[Note]:
+def _noise_note(report: PosteriorReport) -> list[Note]:
     """Where the noise came from, per quantity: measured replicates or the assumed floor."""
     kinds: dict[str, list[str]] = {}
-    for q, text in (report.noise or {}).items():
+    for q, text in report.noise.items():
         kinds.setdefault(text.partition(":")[0], []).append(QUANTITIES[q].label)
     words = {"measured": "measured (the spread of replicate runs) for {}",
              "assumed": "assumed for {}: nothing measured their repeatability, so the "
@@ -428,7 +429,7 @@ def _laws_text(h: Hypothesis) -> str:
     return ", ".join(f"{EFFECTS.get(e, e)}: {law_text(law)}" for e, law in h.laws.items())
 
 
-def _probability_blocks(report: GapReport) -> list[Block]:
+def _probability_blocks(report: PosteriorReport) -> list[Block]:
     """The bar chart of the effect sets' probabilities and the table of the most probable
     hypotheses (effect set, laws, probability, log evidence, fitted strengths)."""
     sets = report.effect_sets
@@ -446,7 +447,7 @@ def _probability_blocks(report: GapReport) -> list[Block]:
                                if not k.startswith("soil.")}) or "—"]
             for i, h in enumerate(hypotheses)]
     effects = ", ".join(f"{EFFECTS.get(e, e)} {probability_text(p)}"
-                        for e, p in sorted((report.effect_probabilities or {}).items(),
+                        for e, p in sorted(report.effect_probabilities.items(),
                                            key=lambda x: -x[1]))
     chosen = next(h for h in report.hypotheses if h.key == report.chosen)
     more = len(report.hypotheses) - len(hypotheses)
@@ -467,7 +468,7 @@ def _probability_blocks(report: GapReport) -> list[Block]:
                                      if k.startswith("soil.")}) + ".")]
 
 
-def _prediction_names(report: GapReport) -> dict[str, str]:
+def _prediction_names(report: PosteriorReport) -> dict[str, str]:
     """The predictions the points carry (key -> words): as given, soil only, chosen."""
     names = dict(PREDICTION_TEXT)
     if report.chosen not in names:
@@ -475,7 +476,7 @@ def _prediction_names(report: GapReport) -> dict[str, str]:
     return names
 
 
-def _relative_offsets(report: GapReport, names: Mapping[str, str]) -> dict:
+def _relative_offsets(report: PosteriorReport, names: Mapping[str, str]) -> dict:
     """For a relative sinkage (unknown zero): each prediction's mean sinkage residual over
     all points, removed before it is drawn (as the diagnosis removes it)."""
     if not report.sinkage_relative:
@@ -485,7 +486,7 @@ def _relative_offsets(report: GapReport, names: Mapping[str, str]) -> dict:
             for k in names} if rows else {}
 
 
-def _curve_blocks(report: GapReport) -> list[Block]:
+def _curve_blocks(report: PosteriorReport) -> list[Block]:
     """Per source (and multipass and gravity level), the measured values against slip
     beside the simulation as given, after soil recalibration and after the chosen
     hypothesis."""
@@ -528,7 +529,7 @@ def _slips_text(slips: Sequence[float]) -> str:
     return f"slip {lo} %" if lo == hi else f"slips {lo} to {hi} %"
 
 
-def _contrast_sentence(c: SiblingContrast, report: GapReport) -> str:
+def _contrast_sentence(c: SiblingContrast, report: PosteriorReport) -> str:
     """``the lugged wheel minus its smooth twin: +2.1 ± 0.4 N of drawbar pull at 80 N (...);
     predicted by grousers (Ding 2011): +1.9 N (the simulation as given: +0.0 N)``."""
     q = QUANTITIES[c.quantity]
@@ -547,7 +548,7 @@ def _contrast_sentence(c: SiblingContrast, report: GapReport) -> str:
                      f"{c.n} matched runs){told}")
 
 
-def _contrast_blocks(report: GapReport) -> list[Block]:
+def _contrast_blocks(report: PosteriorReport) -> list[Block]:
     """The sibling contrasts: what one feature changes at matched conditions, measured
     (with its 95 % interval) beside each prediction's contrast; sentences for those whose
     interval excludes zero (at most :data:`CONTRASTS_TOLD`), every one in the table."""
@@ -590,14 +591,14 @@ def _contrast_blocks(report: GapReport) -> list[Block]:
             Table(header, rows, numeric=frozenset({1, *range(3, len(header))}))]
 
 
-def _schema2_blocks(report: GapReport) -> list[Block]:
+def _schema2_blocks(report: PosteriorReport) -> list[Block]:
     return (_verdict_blocks(report) + _noise_note(report) + _untestable_note(report)
             + _wheel_and_source_notes(report) + _probability_blocks(report)
             + _curve_blocks(report) + _contrast_blocks(report) + _where_blocks(report)
             + _how_far_blocks(report))
 
 
-def _schema1_blocks(report: GapReport) -> list[Block]:
+def _schema1_blocks(report: HeldOutReport) -> list[Block]:
     blocks: list[Block] = [Heading(f"Verdict: {verdict_text(report.verdict)}"),
                            Note(f"Reason, as the diagnosis writes it: {report.reason}",
                                 warning=report.verdict == "inconclusive")]
@@ -613,7 +614,10 @@ def gap_blocks(report: GapReport) -> list[Block]:
     could not be tested, the probabilities (chart and table), the measured curves beside the
     simulation, the sibling contrasts, where (residual maps) and how far (held-out RMSE).
     Schema 1: verdict, reason, test, where, the ranked candidates and how far."""
-    return _schema2_blocks(report) if report.schema2 else _schema1_blocks(report)
+    if isinstance(report, PosteriorReport):
+        return _schema2_blocks(report)
+    assert isinstance(report, HeldOutReport)
+    return _schema1_blocks(report)
 
 
 def gather_gap(session: Session, data: CampaignData) -> dict | None:

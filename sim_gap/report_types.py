@@ -2,15 +2,18 @@
 ``swtlab gap`` read, converted from the JSON at the boundary (a stored file, a database
 record) by :meth:`GapReport.from_json`; :meth:`GapReport.to_json` gives the JSON back as
 :func:`sim_gap.report.build_report` writes it. Both schemas of
-:data:`sim_gap.report.READABLE_SCHEMAS` are read: schema 2 (posterior probabilities) and
-schema 1 (held-out scores, swtlab 0.13). The parts the page reads field by field are typed;
-the free-form tables (regions, points, shrink, wheel, sources, next tests) stay mappings."""
+:data:`sim_gap.report.READABLE_SCHEMAS` are read: schema 2 (posterior probabilities,
+:class:`PosteriorReport`) and schema 1 (held-out scores, swtlab 0.13, :class:`HeldOutReport`).
+The parts the page reads field by field are typed, a law by its authors, year and
+generalisation (:class:`Law`); the free-form tables (regions, points, shrink, wheel,
+sources, next tests, the separating test) stay mappings."""
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, ClassVar, Protocol
 
 import terramechanics as tm
 from sim_gap.candidates import FREE_FORM
@@ -91,7 +94,7 @@ class Explained(Protocol):
 class Hypothesis:
     """One hypothesis of a schema-2 report: ``key`` (effects with their laws), ``label``
     (its effect set), the evidence it rests on and its probabilities; ``parameters``: the
-    fitted values by dotted model name (``soil.kphi``, ``effects.grousers.lambda_``)."""
+    fitted values by dotted model name (``soil.kphi``, ``effects.bulldozing.coefficient``)."""
 
     key: str
     label: str
@@ -227,8 +230,7 @@ class RankedCandidate:
                 **self.other}
 
 
-#: the keys of a schema-2 report that schema 1 lacks, with the value a schema-2 report
-#: written before the key existed is read with
+#: keys a schema-2 report written before they existed lacks, with the value it is read with
 _SCHEMA_2_DEFAULTS: dict[str, Any] = {"learning_rate": None, "next_tests": [],
                                       "admissible_tests": [], "points": [],
                                       "leaders_separation_sigma": None}
@@ -237,16 +239,17 @@ _ADDED = ("wheel", "sources", "effect_sources")
 
 
 @dataclass(frozen=True)
-class GapReport:
-    """A gap report (docs/gap-report.md). ``verdict``: the missing effects (``()`` for
-    none), ``"inconclusive"`` or ``"outside_candidates"``; ``chosen``: the key of the most
-    probable named hypothesis (schema 1: the chosen candidate's label). The schema-2 fields
-    are empty in a schema-1 report and ``candidates``/``decision`` in a schema-2 one;
-    ``wheel``, ``sources`` and ``effect_sources`` are None where the report has none
-    (:func:`sim_gap.report.build_report` alone writes none; :func:`sim_gap.api.gap_report`
-    adds them)."""
+class GapReport(ABC):
+    """What a gap report of either schema holds (docs/gap-report.md): a
+    :class:`PosteriorReport` (schema 2) or a :class:`HeldOutReport` (schema 1).
+    ``verdict``: the missing effects (``()`` for none), ``"inconclusive"`` or
+    ``"outside_candidates"``; ``chosen``: the key of the most probable named hypothesis
+    (schema 1: the chosen candidate's label); ``wheel``, ``sources`` and ``effect_sources``
+    None where the report has none (:func:`sim_gap.report.build_report` alone writes none,
+    :func:`sim_gap.api.gap_report` adds them)."""
 
-    schema: str
+    schema: ClassVar[str]
+
     measured: str
     simulated: str
     verdict: tuple[str, ...] | str
@@ -265,97 +268,131 @@ class GapReport:
     quantities: tuple[str, ...]
     sinkage_relative: bool
     settings: Mapping[str, Any]
-    # schema 2
-    probability: float | None = None
-    call_probability: float | None = None
-    learning_rate: float | None = None
-    next_tests: tuple[Mapping[str, Any], ...] = ()
-    admissible_tests: tuple[Mapping[str, Any], ...] = ()
-    leaders: tuple[Leader, ...] = ()
-    leaders_separation_sigma: float | None = None
-    effect_sets: tuple[EffectSet, ...] = ()
-    effect_probabilities: Mapping[str, float] | None = None
-    hypotheses: tuple[Hypothesis, ...] = ()
-    sibling_contrasts: tuple[SiblingContrast, ...] = ()
-    noise: Mapping[str, str] | None = None
-    points: tuple[Mapping[str, Any], ...] = ()
-    # schema 1
-    candidates: tuple[RankedCandidate, ...] = ()
-    decision: Mapping[str, Any] | None = None
-    # added beside the diagnosis
-    wheel: Mapping[str, Any] | None = None
-    sources: tuple[Mapping[str, Any], ...] | None = None
-    effect_sources: Mapping[str, Any] | None = None
+    wheel: Mapping[str, Any] | None
+    sources: tuple[Mapping[str, Any], ...] | None
+    effect_sources: Mapping[str, Any] | None
 
-    @property
-    def schema2(self) -> bool:
-        return self.schema == SCHEMA
-
+    @abstractmethod
     def explanation(self, key: str) -> Explained:
-        """The hypothesis (schema 1: the candidate) of key ``key``."""
-        found = ([h for h in self.hypotheses if h.key == key]
-                 + [c for c in self.candidates if c.label == key])
+        """The hypothesis (schema 1: the candidate) of key ``key``; KeyError naming it."""
+
+    @abstractmethod
+    def leading(self) -> Sequence[Explained]:
+        """The two leading named explanations the separating test is about."""
+
+    def check(self) -> None:
+        """KeyError naming what the report names but lacks."""
+        self.explanation(self.chosen)
+        self.leading()
+
+    @abstractmethod
+    def _middle(self) -> Json:
+        """The keys of the JSON that are the schema's own, in their place."""
+
+    @staticmethod
+    def from_json(d: Mapping[str, Any]) -> GapReport:
+        """The report of its JSON ``d`` (schema 1 or 2; without ``schema``: 1).
+        :class:`UnknownSchema` for another schema, ``ValueError`` naming the key for a report
+        that lacks one or the hypothesis, candidate or effect set it names but lacks."""
+        schema = d.get("schema", SCHEMA_1)
+        kinds: dict[str, type[PosteriorReport] | type[HeldOutReport]] = {
+            SCHEMA: PosteriorReport, SCHEMA_1: HeldOutReport}
+        if schema not in kinds:
+            raise UnknownSchema(schema)
+        try:
+            report = kinds[schema].read(d, _common(d))
+        except KeyError as exc:
+            raise ValueError(f"gap report ({schema}): no {exc} where the schema has one"
+                             ) from None
+        try:
+            report.check()
+        except KeyError as exc:
+            raise ValueError(exc.args[0]) from None
+        return report
+
+    def to_json(self) -> Json:
+        """The JSON of the report, key for key as :func:`sim_gap.report.build_report` (and
+        :func:`sim_gap.api.gap_report`) wrote it."""
+        head = {"schema": self.schema, "measured": self.measured,
+                "simulated": self.simulated, "verdict": _plain(self.verdict)}
+        tail = {
+            "held_out_rmse_before": _plain(self.held_out_rmse_before),
+            "held_out_rmse_after": _plain(self.held_out_rmse_after),
+            "shrink_pct": _plain(self.shrink_pct), "shrink": _plain(self.shrink),
+            "regions": _plain(self.regions),
+            "untestable_effects": _plain(self.untestable_effects),
+            "contrasts": _plain(self.contrasts), "folds": list(self.folds),
+            "n_points": self.n_points, "quantities": list(self.quantities),
+            "sinkage_relative": self.sinkage_relative, "settings": _plain(self.settings)}
+        added = {k: _plain(getattr(self, k)) for k in _ADDED if getattr(self, k) is not None}
+        return {**head, **self._middle(), **tail, **added}
+
+
+def _common(d: Mapping[str, Any]) -> dict[str, Any]:
+    """The fields of :class:`GapReport` from the JSON ``d``."""
+    verdict, sources = d["verdict"], d.get("sources")
+    return dict(
+        measured=d["measured"], simulated=d["simulated"],
+        verdict=verdict if isinstance(verdict, str) else tuple(verdict),
+        reason=d["reason"], separating_test=d.get("separating_test"), chosen=d["chosen"],
+        held_out_rmse_before=d["held_out_rmse_before"],
+        held_out_rmse_after=d["held_out_rmse_after"], shrink_pct=d["shrink_pct"],
+        shrink=d["shrink"], regions=tuple(d["regions"]),
+        untestable_effects=d["untestable_effects"], contrasts=d["contrasts"],
+        folds=tuple(d["folds"]), n_points=d["n_points"], quantities=tuple(d["quantities"]),
+        sinkage_relative=d["sinkage_relative"], settings=d["settings"], wheel=d.get("wheel"),
+        sources=None if sources is None else tuple(sources),
+        effect_sources=d.get("effect_sources"))
+
+
+@dataclass(frozen=True)
+class PosteriorReport(GapReport):
+    """A schema-2 report: the posterior probability of each hypothesis
+    (:mod:`sim_gap.decide`), the verdict's ``probability`` and the ``call_probability`` it
+    needs, the next tests by expected information gain, the sibling contrasts, the noise's
+    source per quantity and each measured point beside the predictions."""
+
+    schema: ClassVar[str] = SCHEMA
+
+    probability: float
+    call_probability: float
+    learning_rate: float | None
+    next_tests: tuple[Mapping[str, Any], ...]
+    admissible_tests: tuple[Mapping[str, Any], ...]
+    leaders: tuple[Leader, ...]
+    leaders_separation_sigma: float | None
+    effect_sets: tuple[EffectSet, ...]
+    effect_probabilities: Mapping[str, float]
+    hypotheses: tuple[Hypothesis, ...]
+    sibling_contrasts: tuple[SiblingContrast, ...]
+    noise: Mapping[str, str]
+    points: tuple[Mapping[str, Any], ...]
+
+    def explanation(self, key: str) -> Hypothesis:
+        """The hypothesis of key ``key``; KeyError naming it."""
+        found = [h for h in self.hypotheses if h.key == key]
         if not found:
-            raise KeyError(f"gap report: {key!r} is none of its "
-                           + ("hypotheses" if self.schema2 else "candidates"))
+            raise KeyError(f"gap report: {key!r} is none of its hypotheses")
         return found[0]
 
     def effect_set(self, label: str) -> EffectSet:
-        """The effect set of label ``label``."""
+        """The effect set of label ``label``; KeyError naming it."""
         found = [s for s in self.effect_sets if s.label == label]
         if not found:
             raise KeyError(f"gap report: {label!r} is none of its effect sets")
         return found[0]
 
-    def leading(self) -> Sequence[Explained]:
-        """The two leading named explanations the separating test is about: schema 2, the
-        two most probable hypotheses but the outside one; schema 1, the decision's
-        leaders."""
-        if self.schema2:
-            return [h for h in self.hypotheses if not h.outside][:2]
-        return [self.explanation(k) for k in (self.decision or {}).get("leaders") or []]
+    def leading(self) -> list[Hypothesis]:
+        """The two most probable hypotheses but the outside one."""
+        return [h for h in self.hypotheses if not h.outside][:2]
+
+    def check(self) -> None:
+        super().check()
+        for x in self.leaders:
+            self.effect_set(x.label)
 
     @classmethod
-    def from_json(cls, d: Mapping[str, Any]) -> GapReport:
-        """The report of its JSON ``d`` (schema 1 or 2; without ``schema``: 1).
-        :class:`UnknownSchema` for another schema, ``ValueError`` naming the key for a report
-        that lacks one or the hypothesis, candidate or effect set it names but lacks."""
-        schema = d.get("schema", SCHEMA_1)
-        if schema not in READABLE_SCHEMAS:
-            raise UnknownSchema(schema)
-        try:
-            report = cls._read(schema, d)
-        except KeyError as exc:
-            raise ValueError(f"gap report ({schema}): no {exc} where the schema has one"
-                             ) from None
-        try:  # what the report names, it holds
-            report.explanation(report.chosen)
-            report.leading()
-            for leader in report.leaders:
-                report.effect_set(leader.label)
-        except KeyError as exc:
-            raise ValueError(exc.args[0]) from None
-        return report
-
-    @classmethod
-    def _read(cls, schema: str, d: Mapping[str, Any]) -> GapReport:
-        verdict = d["verdict"]
-        sources = d.get("sources")
-        common: dict[str, Any] = dict(
-            schema=schema, measured=d["measured"], simulated=d["simulated"],
-            verdict=verdict if isinstance(verdict, str) else tuple(verdict),
-            reason=d["reason"], separating_test=d.get("separating_test"), chosen=d["chosen"],
-            held_out_rmse_before=d["held_out_rmse_before"],
-            held_out_rmse_after=d["held_out_rmse_after"], shrink_pct=d["shrink_pct"],
-            shrink=d["shrink"], regions=tuple(d["regions"]),
-            untestable_effects=d["untestable_effects"], contrasts=d["contrasts"],
-            folds=tuple(d["folds"]), n_points=d["n_points"], quantities=tuple(d["quantities"]),
-            sinkage_relative=d["sinkage_relative"], settings=d["settings"],
-            wheel=d.get("wheel"), sources=None if sources is None else tuple(sources),
-            effect_sources=d.get("effect_sources"))
-        if schema == SCHEMA_1:
-            return cls(**common, decision=d["decision"],
-                       candidates=tuple(RankedCandidate.from_json(c) for c in d["candidates"]))
+    def read(cls, d: Mapping[str, Any], common: dict[str, Any]) -> PosteriorReport:
         g = {**_SCHEMA_2_DEFAULTS, **d}
         return cls(
             **common, probability=g["probability"], call_probability=g["call_probability"],
@@ -370,42 +407,53 @@ class GapReport:
                                     for c in g["sibling_contrasts"]),
             noise=g["noise"], points=tuple(g["points"]))
 
-    def to_json(self) -> Json:
-        """The JSON of the report, key for key as :func:`sim_gap.report.build_report` (and
-        :func:`sim_gap.api.gap_report`) wrote it."""
-        head: Json = {"schema": self.schema, "measured": self.measured,
-                      "simulated": self.simulated, "verdict": _plain(self.verdict)}
-        if self.schema2:
-            head.update({
-                "probability": self.probability, "call_probability": self.call_probability,
-                "learning_rate": self.learning_rate, "reason": self.reason,
-                "separating_test": _plain(self.separating_test),
-                "next_tests": _plain(self.next_tests),
-                "admissible_tests": _plain(self.admissible_tests), "chosen": self.chosen,
-                "leaders": [x.to_json() for x in self.leaders],
-                "leaders_separation_sigma": self.leaders_separation_sigma,
-                "effect_sets": [s.to_json() for s in self.effect_sets],
-                "effect_probabilities": _plain(self.effect_probabilities),
-                "hypotheses": [h.to_json() for h in self.hypotheses],
-                "sibling_contrasts": [c.to_json() for c in self.sibling_contrasts],
-                "noise": _plain(self.noise), "points": _plain(self.points)})
-        else:
-            head.update({"reason": self.reason,
-                         "separating_test": _plain(self.separating_test),
-                         "chosen": self.chosen,
-                         "candidates": [c.to_json() for c in self.candidates],
-                         "decision": _plain(self.decision)})
-        body = {
-            "held_out_rmse_before": _plain(self.held_out_rmse_before),
-            "held_out_rmse_after": _plain(self.held_out_rmse_after),
-            "shrink_pct": _plain(self.shrink_pct), "shrink": _plain(self.shrink),
-            "regions": _plain(self.regions),
-            "untestable_effects": _plain(self.untestable_effects),
-            "contrasts": _plain(self.contrasts), "folds": list(self.folds),
-            "n_points": self.n_points, "quantities": list(self.quantities),
-            "sinkage_relative": self.sinkage_relative, "settings": _plain(self.settings)}
-        added = {k: _plain(getattr(self, k)) for k in _ADDED if getattr(self, k) is not None}
-        return {**head, **body, **added}
+    def _middle(self) -> Json:
+        return {
+            "probability": self.probability, "call_probability": self.call_probability,
+            "learning_rate": self.learning_rate, "reason": self.reason,
+            "separating_test": _plain(self.separating_test),
+            "next_tests": _plain(self.next_tests),
+            "admissible_tests": _plain(self.admissible_tests), "chosen": self.chosen,
+            "leaders": [x.to_json() for x in self.leaders],
+            "leaders_separation_sigma": self.leaders_separation_sigma,
+            "effect_sets": [s.to_json() for s in self.effect_sets],
+            "effect_probabilities": _plain(self.effect_probabilities),
+            "hypotheses": [h.to_json() for h in self.hypotheses],
+            "sibling_contrasts": [c.to_json() for c in self.sibling_contrasts],
+            "noise": _plain(self.noise), "points": _plain(self.points)}
+
+
+@dataclass(frozen=True)
+class HeldOutReport(GapReport):
+    """A schema-1 report (swtlab 0.13): the candidates ranked by their held-out score;
+    ``decision``: the decision's details as written (its ``leaders``: the two leading
+    candidates' labels)."""
+
+    schema: ClassVar[str] = SCHEMA_1
+
+    candidates: tuple[RankedCandidate, ...]
+    decision: Mapping[str, Any]
+
+    def explanation(self, key: str) -> RankedCandidate:
+        """The candidate of label ``key``; KeyError naming it."""
+        found = [c for c in self.candidates if c.label == key]
+        if not found:
+            raise KeyError(f"gap report: {key!r} is none of its candidates")
+        return found[0]
+
+    def leading(self) -> list[RankedCandidate]:
+        """The candidates of the decision's ``leaders``."""
+        return [self.explanation(k) for k in self.decision.get("leaders") or []]
+
+    @classmethod
+    def read(cls, d: Mapping[str, Any], common: dict[str, Any]) -> HeldOutReport:
+        return cls(**common, decision=d["decision"],
+                   candidates=tuple(RankedCandidate.from_json(c) for c in d["candidates"]))
+
+    def _middle(self) -> Json:
+        return {"reason": self.reason, "separating_test": _plain(self.separating_test),
+                "chosen": self.chosen, "candidates": [c.to_json() for c in self.candidates],
+                "decision": _plain(self.decision)}
 
 
 def _plain(value: Any) -> Any:

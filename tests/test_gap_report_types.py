@@ -13,7 +13,7 @@ import pytest
 
 import terramechanics as tm
 from sim_gap.candidates import FREE_FORM
-from sim_gap.report_types import GapReport, Law, UnknownSchema
+from sim_gap.report_types import GapReport, HeldOutReport, Law, PosteriorReport, UnknownSchema
 
 DATA = Path(__file__).parent
 SCHEMA_2_REPORT = DATA / "reference" / "sample_campaign" / "gap.json"
@@ -45,7 +45,8 @@ def test_build_reports_json_without_the_wheel_gives_it_back_without_the_wheel():
 def test_the_typed_fields_are_the_jsons():
     written = _load(SCHEMA_2_REPORT)
     report = GapReport.from_json(written)
-    assert report.schema2 and report.verdict == () and report.chosen == "soil_only"
+    assert isinstance(report, PosteriorReport)
+    assert report.verdict == () and report.chosen == "soil_only"
     assert report.probability == written["probability"] == pytest.approx(0.99924509517)
     h = report.hypotheses[1]
     assert h.key == "bulldozing(rankine_terzaghi1943)" and h.effects == ("bulldozing",)
@@ -55,10 +56,11 @@ def test_the_typed_fields_are_the_jsons():
                                                       "outside_candidates"]
     assert report.effect_set("bulldozing").effects == ("bulldozing",)
     assert report.explanation("soil_only") is report.hypotheses[0]
+    assert report.leading() == [report.hypotheses[0], report.hypotheses[1]]
     c = report.sibling_contrasts[0]
     assert c.ci95 == tuple(written["sibling_contrasts"][0]["ci95"]) and c.feature == "multipass"
     v1 = GapReport.from_json(_load(SCHEMA_1_REPORT))
-    assert not v1.schema2 and v1.verdict == "inconclusive" and v1.hypotheses == ()
+    assert isinstance(v1, HeldOutReport) and v1.verdict == "inconclusive"
     assert [x.label for x in v1.leading()] == ["grousers(ding2011)", "soil_only"]
     assert v1.candidates[0].laws["wheel_flexibility"] == Law("wong2010", ("Wong",), 2010)
 

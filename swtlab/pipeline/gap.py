@@ -42,11 +42,16 @@ class GapReport:
         return self.data
 
     @property
-    def typed(self) -> report_types.GapReport:
-        """The report as typed objects (:class:`sim_gap.report_types.GapReport`)."""
-        from sim_gap.report_types import GapReport as Typed
+    def typed(self) -> report_types.PosteriorReport:
+        """The report as typed objects (:class:`sim_gap.report_types.PosteriorReport`: the
+        schema :func:`diagnose_gap` writes)."""
+        from sim_gap.report_types import GapReport as Typed, PosteriorReport
 
-        return Typed.from_json(self.data)
+        report = Typed.from_json(self.data)
+        if not isinstance(report, PosteriorReport):
+            raise ValueError(f"gap report of schema {report.schema}: diagnose_gap writes "
+                             f"{PosteriorReport.schema}")
+        return report
 
     def write(self, json_path: str | Path | None = None,
               html_path: str | Path | None = None) -> None:
