@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -239,7 +241,7 @@ def slip_band_text(label: str) -> str:
     return f"{SLIP_BAND_EDGES[i] * 100:g} to {SLIP_BAND_EDGES[i + 1] * 100:g}"
 
 
-def condition_text(region: dict, varying: set[str]) -> str:
+def condition_text(region: Mapping[str, Any], varying: set[str]) -> str:
     """A region's conditions in words, only the factors that vary in the campaign."""
     parts = [f"{region['load_n']:g} N"]
     if "multipass" in varying:
@@ -249,11 +251,11 @@ def condition_text(region: dict, varying: set[str]) -> str:
     return ", ".join(parts)
 
 
-def varying_factors(regions: list[dict]) -> set[str]:
+def varying_factors(regions: Sequence[Mapping[str, Any]]) -> set[str]:
     return {k for k in ("multipass", "gravity_mps2") if len({r[k] for r in regions}) > 1}
 
 
-def gap_heatmap(regions: list[dict], tag: str = "") -> Figure:
+def gap_heatmap(regions: Sequence[Mapping[str, Any]], tag: str = "") -> Figure:
     """The residual map of a gap report (``sim_gap.regions.residual_map``): one panel per
     quantity, rows = load (and multipass, gravity where they vary), columns = slip bands,
     colour = mean residual (measured − simulated) in % of the load (torque: of load × wheel
@@ -335,7 +337,7 @@ def probability_text(p: float) -> str:
 PREDICTION_LINES = {"simulation": (":", 1.2), "soil_only": ("--", 1.2), None: ("-", 1.8)}
 
 
-def gap_curves(groups: list[tuple[str, list[dict]]], quantities: list[str],
+def gap_curves(groups: list[tuple[str, list[Mapping[str, Any]]]], quantities: list[str],
                lines: dict[str, str], palette: Palette, offsets: dict | None = None) -> Figure:
     """Measured against simulated, one row per group (``(title, points)``: a source at one
     multipass and gravity level, its points as the gap report's ``points``) and one column

@@ -90,22 +90,22 @@ def run(args: argparse.Namespace) -> int:
     except (OSError, ValueError, KeyError) as exc:
         print(f"swtlab gap: {exc}", file=sys.stderr)
         return exit_codes.BAD_INPUT
-    report = gap.to_dict()
-    for line in report["wheel"]["mismatches"]:
+    report = gap.typed
+    for line in (report.wheel or {}).get("mismatches", []):
         print(f"wheel mismatch allowed: {line}")
-    if len(report["sources"]) > 1:
-        for effect in report["effect_sources"].values():
+    if len(report.sources or ()) > 1:
+        for effect in (report.effect_sources or {}).values():
             print(effect["text"])
-    verdict = report["verdict"]
+    verdict = report.verdict
     print("verdict:", verdict if isinstance(verdict, str) else (", ".join(verdict) or "none"))
-    print("reason:", report["reason"])
-    for entry in report["effect_sets"][:3]:
-        print(f"  P({entry['label']}) = {entry['probability']:.3f}")
-    for test in report.get("next_tests") or []:
+    print("reason:", report.reason)
+    for entry in report.effect_sets[:3]:
+        print(f"  P({entry.label}) = {entry.probability:.3f}")
+    for test in report.next_tests:
         print(f"next test ({test['gain_bits']:.2f} bits expected): {test['test']}")
-    if report.get("separating_test"):
-        print("where the gap is largest:", report["separating_test"]["test"])
-    for q, before in report["held_out_rmse_before"].items():
-        print(f"{q}: held-out RMSE {before:.4g} -> {report['held_out_rmse_after'][q]:.4g} "
-              f"({report['shrink_pct'][q]:.1f} % shrink)")
+    if report.separating_test:
+        print("where the gap is largest:", report.separating_test["test"])
+    for q, before in report.held_out_rmse_before.items():
+        print(f"{q}: held-out RMSE {before:.4g} -> {report.held_out_rmse_after[q]:.4g} "
+              f"({report.shrink_pct[q]:.1f} % shrink)")
     return exit_codes.OK

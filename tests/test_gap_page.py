@@ -43,6 +43,7 @@ from sim_gap.diagnose import Settings
 from sim_gap.hypotheses import OUTSIDE
 from sim_gap.measured import load_measured
 from sim_gap.report import READABLE_SCHEMAS
+from sim_gap.report_types import EffectSet, GapReport, Hypothesis, Law, RankedCandidate
 from sim_gap.simulated import Simulated
 from test_report_browser import CHROMIUM, probe
 
@@ -75,7 +76,8 @@ def report() -> dict:
 @pytest.fixture(scope="module")
 def page_file(report, tmp_path_factory) -> Path:
     """The page of :func:`report`, written once."""
-    return write_gap_page(report, tmp_path_factory.mktemp("gap") / "gap.html")
+    return write_gap_page(GapReport.from_json(report),
+                          tmp_path_factory.mktemp("gap") / "gap.html")
 
 
 @pytest.fixture(scope="module")
@@ -191,7 +193,7 @@ def test_schema2_page_says_what_the_json_says(report, page_file):
                 assert f"{PARAMETERS[name].label} = {value_text(PARAMETERS[name], value)}" \
                     in row[5]
         for effect, law in h["laws"].items():
-            assert f"{EFFECTS[effect]}: {law_text(law)}" in row[2]
+            assert f"{EFFECTS[effect]}: {law_text(Law.of(effect, law))}" in row[2]
     assert len(table["rows"]) - 1 == min(8, len(report["hypotheses"]))
     # the noise: where it came from, per quantity
     noise = next(t for t in page.text if t.startswith("Noise (the error bars, σ): "))
@@ -219,7 +221,8 @@ def test_schema2_page_says_what_the_json_says(report, page_file):
     dp = next(c for c in contrasts if c["quantity"] == "dp_n")
     assert f"of drawbar pull at 80 N (95 % interval; slips 0 to 60 %, {dp['n']} matched runs)" \
         in sentence
-    assert f"predicted by {candidate_text(report['chosen'])}: " in sentence
+    chosen = GapReport.from_json(report).explanation(report["chosen"])
+    assert f"predicted by {candidate_text(chosen)}: " in sentence
     # the figures: probabilities, curves, two residual maps
     alts = [i["alt"] for i in page.images]
     assert alts[0].startswith("Posterior probability of each effect set")
@@ -229,7 +232,8 @@ def test_schema2_page_says_what_the_json_says(report, page_file):
 
 
 def test_probability_chart_bars_are_the_effect_sets(report):
-    sets = [(candidate_text(s["label"]), s["probability"]) for s in report["effect_sets"]]
+    sets = [(candidate_text(EffectSet.from_json(s)), s["probability"])
+            for s in report["effect_sets"]]
     fig = gap_probabilities(sets, 0.9)
     (ax,) = fig.axes
     widths = [p.get_width() for p in ax.patches]
@@ -267,7 +271,7 @@ def test_curves_are_the_measured_points_and_the_predictions(report):
 def verdict_words(report: dict) -> Page:
     """The verdict's part of the page (heading, rule, reason, next test) as the page shows
     it, checked like the whole page (no JSON, no code name but in the reason)."""
-    blocks = _verdict_blocks(report)
+    blocks = _verdict_blocks(GapReport.from_json(report))
     html = "".join(f"<p>{escape(b.text)}</p>" for b in blocks)
     page = Page(html)
     assert not CODE_NAMES.search(page.words), CODE_NAMES.search(page.words).group(0)
@@ -305,11 +309,13 @@ def test_inconclusive_names_the_leaders_and_never_the_outside(report):
     page = verdict_words(tied)
     text = " ".join(page.text)
     assert "Verdict: inconclusive" in page.text
-    leaders = ", ".join(f"{candidate_text(x['label'])} {cut3(x['probability'])}"
+    sets = {s["label"]: EffectSet.from_json(s) for s in tied["effect_sets"]}
+    leaders = ", ".join(f"{candidate_text(sets[x['label']])} {cut3(x['probability'])}"
                         for x in tied["leaders"])
     assert f"None reaches it here; the most probable: {leaders}." in text
     assert REASON + tied["reason"] in page.text
-    who = f"{candidate_text(first['key'])} and {candidate_text(second['key'])}"
+    who = (f"{candidate_text(Hypothesis.from_json(first))} and "
+           f"{candidate_text(Hypothesis.from_json(second))}")
     assert (f"Next test: add skid (braked) slips (-0.5, -0.2); {who} differ there by up to "
             "2.5 σ (σ: the repeatability floor).") in page.text
     tied["separating_test"] = None
@@ -363,7 +369,8 @@ def test_a_call_and_the_outside_verdict_in_words(report):
 
 def test_schema1_report_still_renders(report_v1, tmp_path):
     assert report_v1["schema"] == READABLE_SCHEMAS[0]
-    page = check_page(write_gap_page(report_v1, tmp_path / "gap.html").read_text("utf-8"))
+    page = check_page(write_gap_page(GapReport.from_json(report_v1),
+                                     tmp_path / "gap.html").read_text("utf-8"))
     text = " ".join(page.text)
     assert "Verdict: inconclusive" in page.text
     assert REASON + report_v1["reason"] in page.text
@@ -371,7 +378,7 @@ def test_schema1_report_still_renders(report_v1, tmp_path):
             "recalibration only differ there by up to 39.8 σ") in text
     table = page.table("rank")
     for row, c in zip(table["rows"][1:], report_v1["candidates"]):
-        assert row[1] == candidate_text(c["label"])
+        assert row[1] == candidate_text(RankedCandidate.from_json(c))
         assert float(row[2]) == pytest.approx(c["held_out_score"], rel=5e-3)
     rmse = page.table("held-out RMSE")
     before = next(r for r in rmse["rows"] if r and r[0] == "before: soil recalibration only")
@@ -383,7 +390,9 @@ def test_schema1_report_still_renders(report_v1, tmp_path):
 
 
 def test_an_unknown_schema_is_said_not_guessed(report):
-    (note,) = gap_blocks(dict(report, schema="swtlab.gap-report/9"))
+    newer = dict(report, schema="swtlab.gap-report/9")
+    data = SimpleNamespace(extras={"gap": {"sim_source": "sim.toml", "report": newer}})
+    (note,) = gap_section(data, palette=None).blocks
     assert isinstance(note, Note) and note.warning
     assert note.text.startswith("This gap report has schema swtlab.gap-report/9")
 
@@ -398,7 +407,7 @@ def test_campaign_section_and_gap_page_share_the_renderer(report, monkeypatch):
     monkeypatch.setattr("campaign_report.gap.to_png", drawn)
     data = SimpleNamespace(extras={"gap": {"sim_source": "sim.toml", "report": report}})
     section = gap_section(data, palette=None)
-    page = gap_page(report)
+    page = gap_page(GapReport.from_json(report))
     assert section.blocks[1:] == page.sections[0].blocks
     assert isinstance(section.blocks[1], Heading) and section.blocks[1].text.startswith(
         "Verdict: ")
@@ -423,25 +432,76 @@ def test_heatmap_axes_and_colour_in_percent_of_load(report):
         "0 to 20", "20 to 40", "40 to 60", "60 to 100"]
 
 
-def test_plain_words_and_display_units():
-    assert candidate_text("slip_sinkage+grousers") == "slip sinkage + grousers"
-    assert candidate_text("outside_candidates") == "an effect outside the candidates"
-    assert candidate_text("grousers(ding2011)+reduced_gravity(wong_kobayashi2012)") == (
+REFERENCE_REPORT = ROOT / "tests" / "reference" / "sample_campaign" / "gap.json"
+
+
+def test_the_reference_reports_name_their_laws_as_the_pattern_matching_did(monkeypatch):
+    """The hypotheses, laws and chosen explanation in words, from the typed report's fields,
+    as the regular expression over the law keys wrote them (swtlab 0.15.0): the sample
+    campaign's stored report (schema 2) and the 0.13.0 report (schema 1)."""
+    monkeypatch.setattr("campaign_report.gap.to_png", lambda fig: (b"", None))
+    blocks = gap_blocks(GapReport.from_json(json.loads(REFERENCE_REPORT.read_text("utf-8"))))
+    texts = [b.text for b in blocks if isinstance(b, (Heading, Note))]
+    (table,) = [b for b in blocks if getattr(b, "header", [""])[0] == "rank"]
+    assert {tuple(row[1:3]) for row in table.rows} == {
+        ("no missing effect", "—"), ("an effect outside the candidates", "—"),
+        ("bulldozing", "bulldozing: Rankine & Terzaghi 1943"),
+        ("bulldozing", "bulldozing: Rankine & Terzaghi 1943, resistance varying with rut "
+                       "depth"),
+        ("bulldozing", "bulldozing: Bekker 1969"),
+        ("bulldozing", "bulldozing: Bekker 1969, resistance varying with rut depth")}
+    assert "Verdict: no missing effect (probability 0.999)" in texts
+    assert any(t.startswith("Soil fitted under the most probable named hypothesis (soil "
+                            "recalibration only): ") for t in texts)
+    assert "How far: held-out RMSE of soil recalibration only (no effect chosen)" in texts
+    assert any("; predicted by soil recalibration only: " in t for t in texts)
+    v1 = GapReport.from_json(json.loads(SCHEMA_1_REPORT.read_text(encoding="utf-8")))
+    blocks = gap_blocks(v1)
+    texts = [b.text for b in blocks if isinstance(b, (Heading, Note))]
+    (table,) = [b for b in blocks if getattr(b, "header", [""])[0] == "rank"]
+    assert [row[1] for row in table.rows] == [
+        "grousers (Ding 2011) + wheel flexibility (Wong 2010)",
+        "grousers (Ding 2011) + wheel flexibility (Bekker 1969)",
+        "grousers (Ding 2011) + bulldozing (Rankine & Terzaghi 1943)",
+        "grousers (Ding 2011) + bulldozing (Bekker 1969)", "grousers (Ding 2011)",
+        "grousers (Bekker 1956) + wheel flexibility (Wong 2010)", "grousers (Bekker 1956)",
+        "grousers (Bekker 1956) + bulldozing (Bekker 1969)"]
+    assert "How far: held-out RMSE, soil recalibration only against grousers (Ding 2011)" \
+        in texts
+    assert ("Held-out RMSE per slip band, before → after (soil recalibration only → grousers "
+            "(Ding 2011)): where the gap remains.") in texts
+
+
+def explained(laws: dict[str, str], outside: bool = False) -> SimpleNamespace:
+    """A hypothesis as the page reads it: its effects with their laws."""
+    return SimpleNamespace(effects=tuple(laws), laws={e: Law.of(e, law) for e, law in
+                                                      laws.items()}, outside=outside)
+
+
+def test_plain_words_and_display_units(report_v1):
+    assert candidate_text(EffectSet("slip_sinkage+grousers", ("slip_sinkage", "grousers"),
+                                    0.5)) == "slip sinkage + grousers"
+    assert candidate_text(explained({}, outside=True)) == "an effect outside the candidates"
+    assert candidate_text(explained({})) == "soil recalibration only"
+    assert candidate_text(explained({"grousers": "ding2011",
+                                     "reduced_gravity": "wong_kobayashi2012"})) == (
         "grousers (Ding 2011) + reduced gravity (Wong & Kobayashi 2012)")
-    assert candidate_text("grousers(bekker1956~slip)+bulldozing(rankine_terzaghi1943~depth)") == (
+    assert candidate_text(explained({"grousers": "bekker1956~slip",
+                                     "bulldozing": "rankine_terzaghi1943~depth"})) == (
         "grousers (Bekker 1956, with the lugs' slip-sinkage) + bulldozing (Rankine & Terzaghi "
         "1943, resistance varying with rut depth)")
+    assert law_text(Law.of("grousers", "free_form")) == (
+        "a shape none of its laws has: what differs between the levels")
     for effect, laws in tm.LAWS.items():
         for law in laws:
-            assert "_" not in candidate_text(f"{effect}({law})")
-    two = {"candidates": [], "decision": {"leaders": ["grousers", "slip_sinkage"]},
-           "separating_test": {
+            assert "_" not in candidate_text(explained({effect: law}))
+    two = GapReport.from_json(dict(report_v1, separating_test={
         "test": "test at another gravity (3.71 m/s^2, gravity-offload rig or parabolic flight)",
-        "separation_sigma": 5.25}}
+        "separation_sigma": 5.25}))
     assert decisive_test_text(two) == (
         "Next test: test at another gravity (3.71 m/s², gravity-offload rig or parabolic "
-        "flight); grousers and slip sinkage differ there by up to 5.25 σ (σ: the "
-        "repeatability floor).")
+        "flight); grousers (Ding 2011) and soil recalibration only differ there by up to "
+        "5.25 σ (σ: the repeatability floor).")
     assert _folds_text(["load=70", "load=120", "multipass=0", "multipass=1", "multipass=2"]) \
         == "each load (70 N, 120 N); each multipass (0, 1, 2)"
     assert _folds_text(["slip band 0", "slip band 4"]) == \

@@ -11,6 +11,7 @@ import pandas as pd
 from swtlab.pipeline.campaign import Campaign
 
 if TYPE_CHECKING:
+    from sim_gap import report_types
     from sim_gap.simulated import Simulated
     from terramechanics import WheelModel
 
@@ -42,6 +43,18 @@ class GapReport:
     def to_dict(self) -> dict:
         return self.data
 
+    @property
+    def typed(self) -> report_types.PosteriorReport:
+        """The report as typed objects (:class:`sim_gap.report_types.PosteriorReport`: the
+        schema :func:`diagnose_gap` writes)."""
+        from sim_gap.report_types import GapReport as Typed, PosteriorReport
+
+        report = Typed.from_json(self.data)
+        if not isinstance(report, PosteriorReport):
+            raise ValueError(f"gap report of schema {report.schema}: diagnose_gap writes "
+                             f"{PosteriorReport.schema}")
+        return report
+
     def write(self, json_path: str | Path | None = None,
               html_path: str | Path | None = None) -> None:
         """Write the JSON and the self-contained HTML page (the campaign report's gap
@@ -52,7 +65,7 @@ class GapReport:
         if json_path:
             write_json(self.data, json_path)
         if html_path:
-            write_gap_page(self.data, html_path)
+            write_gap_page(self.typed, html_path)
 
 
 def _points(measured: object) -> tuple[pd.DataFrame, str]:
