@@ -19,6 +19,7 @@ import terramechanics as tm
 from sim_gap.candidates import FREE_FORM
 from sim_gap.hypotheses import OUTSIDE
 from sim_gap.report import READABLE_SCHEMAS, SCHEMA
+from swtlab_base.errors import InputError
 
 SCHEMA_1 = READABLE_SCHEMAS[0]
 SOIL_ONLY = "soil_only"
@@ -28,7 +29,7 @@ _YEAR_DIGITS = 4
 Json = dict[str, Any]
 
 
-class UnknownSchema(ValueError):
+class UnknownSchema(InputError, ValueError):
     """A gap report of a schema this swtlab does not read (a newer swtlab wrote it)."""
 
     def __init__(self, schema: str) -> None:
