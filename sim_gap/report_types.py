@@ -13,7 +13,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar, Protocol
+from typing import Any, ClassVar, Protocol, TypeVar
 
 import terramechanics as tm
 from sim_gap.candidates import FREE_FORM
@@ -371,17 +371,11 @@ class PosteriorReport(GapReport):
 
     def explanation(self, key: str) -> Hypothesis:
         """The hypothesis of key ``key``; KeyError naming it."""
-        found = [h for h in self.hypotheses if h.key == key]
-        if not found:
-            raise KeyError(f"gap report: {key!r} is none of its hypotheses")
-        return found[0]
+        return _one(self.hypotheses, "key", key, "hypotheses")
 
     def effect_set(self, label: str) -> EffectSet:
         """The effect set of label ``label``; KeyError naming it."""
-        found = [s for s in self.effect_sets if s.label == label]
-        if not found:
-            raise KeyError(f"gap report: {label!r} is none of its effect sets")
-        return found[0]
+        return _one(self.effect_sets, "label", label, "effect sets")
 
     def leading(self) -> list[Hypothesis]:
         """The two most probable hypotheses but the outside one."""
@@ -437,10 +431,7 @@ class HeldOutReport(GapReport):
 
     def explanation(self, key: str) -> RankedCandidate:
         """The candidate of label ``key``; KeyError naming it."""
-        found = [c for c in self.candidates if c.label == key]
-        if not found:
-            raise KeyError(f"gap report: {key!r} is none of its candidates")
-        return found[0]
+        return _one(self.candidates, "label", key, "candidates")
 
     def leading(self) -> list[RankedCandidate]:
         """The candidates of the decision's ``leaders``."""
@@ -455,6 +446,18 @@ class HeldOutReport(GapReport):
         return {"reason": self.reason, "separating_test": _plain(self.separating_test),
                 "chosen": self.chosen, "candidates": [c.to_json() for c in self.candidates],
                 "decision": _plain(self.decision)}
+
+
+_T = TypeVar("_T")
+
+
+def _one(items: Sequence[_T], field: str, value: str, what: str) -> _T:
+    """The first of ``items`` whose ``field`` is ``value``; KeyError naming it and ``what``
+    the report holds."""
+    for item in items:
+        if getattr(item, field) == value:
+            return item
+    raise KeyError(f"gap report: {value!r} is none of its {what}")
 
 
 def _plain(value: Any) -> Any:
