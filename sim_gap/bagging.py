@@ -12,8 +12,9 @@ are neither reproducible nor calibrated. The bagged posterior is stable under re
 of the runs, and concentrates on one hypothesis only where the runs agree on it; where the
 models are right it agrees with Bayes' rule (Huggins & Miller, Theorems 1-3).
 
-Each copy resamples the campaign's runs (points) with replacement; a run drawn ``m`` times
-counts as the mean of ``m`` runs at its condition (:func:`_copy`). Each hypothesis' evidence on a copy is the linearised Laplace evidence of
+Each copy resamples the campaign's runs (points) with replacement; a run drawn ``m``
+times counts as the mean of ``m`` runs at its condition (:func:`_copy`). Each hypothesis'
+evidence on a copy is the linearised Laplace evidence of
 :func:`sim_gap.evidence.log_evidence` at its most probable discrepancy, nugget and run-soil
 sizes on the whole campaign (type-II; the sizes are not refitted per copy), plus the Occam
 factor of those sizes on the whole campaign, with the same truncated priors.
