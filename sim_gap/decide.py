@@ -8,7 +8,9 @@
 misspecified (Grünwald & van Ommen 2017, Bayesian Analysis 12:1069-1103): the base model
 is another solver than the lab's wheel, and what one run's soil does to its drawbar pull,
 torque and sinkage together is not in the noise model, so the evidence counts the same
-information several times. An effect set's
+information several times. The report's probabilities are this posterior bagged over
+bootstrap copies of the campaign's runs (:mod:`sim_gap.bagging`): misspecified hypotheses
+make Bayes' rule concentrate on whichever one the particular runs favour. An effect set's
 probability is the sum over the laws it was fitted under (a family of laws is one
 hypothesis about the physics, its laws are ways to draw it); an effect's probability is the
 sum over the sets that contain it.
@@ -32,16 +34,19 @@ from sim_gap.hypotheses import OUTSIDE
 CALL_PROBABILITY = 0.9
 
 
-def learning_rate(chi2: float, n_entries: int, n_params: int) -> float:
-    """The power on the evidence: ``1 / phi``, at most one, with ``phi`` the Pearson
-    dispersion of the best fit, ``chi2 / (n_entries - n_params)`` (residuals standardised by
-    the fit's noise). Quasi-likelihood divides the log likelihood of an overdispersed model
-    by its dispersion (Wedderburn 1974, Biometrika 61:439-447; McCullagh & Nelder 1989,
-    Generalized Linear Models, sec. 9.2): a model that misses its points by ``sqrt(phi)``
-    times its noise learns ``phi`` times less from each of them. A model that fits to its
-    noise (``phi <= 1``) keeps Bayes' rule."""
-    phi = chi2 / max(n_entries - n_params, 1)
-    return float(min(1.0, 1.0 / phi)) if phi > 0 else 1.0
+def learning_rate(dispersion: float) -> float:
+    """The power on the evidence: ``1 / phi``, at most one, with ``phi`` the held-out
+    dispersion of the most probable named hypothesis' own model (noise, run soil, nugget,
+    discrepancy and parameters; :func:`sim_gap.evidence.held_out_dispersion`).
+    Quasi-likelihood divides the log likelihood of an overdispersed model by its dispersion
+    (Wedderburn 1974, Biometrika 61:439-447; McCullagh & Nelder 1989, Generalized Linear
+    Models, sec. 9.2): a model whose held-out runs scatter ``sqrt(phi)`` times wider than its
+    covariance says learns ``phi`` times less from each of them. The dispersion is that of
+    the model whose evidence is tempered, measured on runs it did not see: measured against
+    the noise alone it would count the discrepancy and the run soil the model already
+    carries as misfit a second time. A model whose held-out runs scatter as it says
+    (``phi <= 1``) keeps Bayes' rule."""
+    return float(min(1.0, 1.0 / dispersion)) if dispersion > 0 else 1.0
 
 
 def posterior(log_evidence: dict[str, float], prior: dict[str, float],

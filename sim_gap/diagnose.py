@@ -7,21 +7,24 @@ Pure: points and a simulation in, a dict out."""
 from __future__ import annotations
 
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
+from scipy.special import logsumexp
 from threadpoolctl import threadpool_limits
 
 
 from sim_gap import candidates as cands
+from sim_gap.bagging import N_BAGS, BagModel, bagged_posterior, grid_values
 from sim_gap.crossval import contrasts, cross_validate, folds
-from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate, posterior
-from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances, log_evidence,
-                              observations)
+from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate
+from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances, held_out_dispersion,
+                              log_evidence, observations, run_soil)
 from sim_gap.fit import (MapFit, fit_map, internal_bounds, quantities_of, sigmas, strengths,
                          to_values)
-from sim_gap.hypotheses import OUTSIDE, admissible, hypothesis_priors, param_prior
+from sim_gap.hypotheses import (OUTSIDE, admissible, hypothesis_priors, param_prior,
+                                set_prior)
 from sim_gap.next_test import TOP_TESTS, next_tests
 from sim_gap.regions import largest_gap, residual_map
 from sim_gap.shrink import shrink
@@ -44,7 +47,8 @@ CONTRAST_NEEDED = {"multipass": "a second multipass level",
 @dataclass(frozen=True)
 class Settings:
     """``max_nfev``/``fold_nfev``: evaluations of a MAP fit / a held-out fold fit (the
-    shrink's two candidates); ``n_boot``: bootstrap replicates; ``jobs``: worker processes
+    shrink's two candidates); ``n_boot``: bootstrap replicates of the shrink; ``n_bags``:
+    bootstrap copies of the bagged posterior (:mod:`sim_gap.bagging`); ``jobs``: worker processes
     for the candidate fits; ``laws``: effect -> the laws its candidates may use (default:
     every law of the family; see
     ``sim_gap.candidates.allowed_laws``)."""
@@ -55,6 +59,7 @@ class Settings:
     jobs: int = 1
     seed: int = 0
     laws: dict[str, tuple[str, ...]] | None = None
+    n_bags: int = N_BAGS
 
 
 def testable(sim: Simulated, points: pd.DataFrame, laws: dict[str, tuple[str, ...]]
@@ -162,9 +167,20 @@ def _levels(points: pd.DataFrame, effect: str) -> np.ndarray | None:
     return levels if len(set(levels.tolist())) >= 2 else None
 
 
+def _bag(sim: Simulated, obs, cov, amplitudes: np.ndarray | None, f: MapFit, e: Evidence
+         ) -> BagModel:
+    """What the bagged posterior needs of hypothesis fit ``f`` with evidence ``e`` on the
+    covariances ``cov`` of ``obs`` (:mod:`sim_gap.bagging`)."""
+    centre, sd = param_prior(f.fit.candidate, sim.model)
+    lo, hi = internal_bounds(f.fit.candidate)
+    return BagModel(obs, grid_values(cov, amplitudes, e.best_grid), f.predicted, f.jac,
+                    f.internal - centre, sd, (lo - centre, hi - centre),
+                    e.log_evidence - e.log_at_best)
+
+
 def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit],
                reference: dict[str, str], amplitudes: np.ndarray
-               ) -> dict[str, tuple[cands.Candidate, MapFit, Evidence]]:
+               ) -> dict[str, tuple[cands.Candidate, MapFit, Evidence, BagModel]]:
     """Each level effect (multipass, reduced gravity, grousers with a sibling wheel) with a
     shape none of its laws has: the discrepancy apart per level of its factor, sized as the
     candidate effects are (``amplitudes``), on top of soil recalibration alone or with each
@@ -176,13 +192,38 @@ def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit
         levels = _levels(points, effect) if effect in cands.LEVEL_FACTOR else None
         if levels is None:
             continue
-        cov = covariances(apart_by(obs, levels), amplitudes)
+        apart = apart_by(obs, levels)
+        cov = covariances(apart, amplitudes)
         bases = [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()
                                        if e != effect]
         for base in bases:
             c = cands.with_free_form(base.fit.candidate, effect)
-            out[c.key] = (c, base, _evidence(cov, obs, sim, base))
+            e = _evidence(cov, obs, sim, base)
+            out[c.key] = (c, base, e, _bag(sim, apart, cov, amplitudes, base, e))
     return out
+
+
+def outside(sim: Simulated, obs, amplitudes: np.ndarray, fits: dict[str, MapFit],
+            reference: dict[str, str], n_admissible: int
+            ) -> tuple[MapFit, Evidence, list[tuple[BagModel, float]]]:
+    """The hypothesis "an effect outside the candidates": a discrepancy apart per source and
+    level (sized as the candidate effects are, ``amplitudes``) on top of soil recalibration
+    alone or of one candidate effect under its reference law. Its prior
+    (:func:`sim_gap.hypotheses.outside_prior`) is that of an effect outside the vocabulary
+    at work beside any of the candidates, so its evidence is the mixture over those bases
+    weighted by their effect sets' priors (:func:`sim_gap.hypotheses.set_prior`). Returns
+    the most probable base's fit, the mixture's evidence (with that base's discrepancy
+    sizes) and each base's bagging model with its weight."""
+    cov = covariances(obs, amplitudes)
+    bases = [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()]
+    each = [_evidence(cov, obs, sim, f) for f in bases]
+    log_weight = np.log([set_prior(f.fit.candidate.effects, n_admissible) for f in bases])
+    log_weight -= logsumexp(log_weight)
+    terms = log_weight + np.array([e.log_evidence for e in each])
+    best = int(np.argmax(terms))
+    bags = [(_bag(sim, obs, cov, amplitudes, f, e), float(np.exp(w)))
+            for f, e, w in zip(bases, each, log_weight)]
+    return bases[best], replace(each[best], log_evidence=float(logsumexp(terms))), bags
 
 
 def _leading_sets(hypotheses: list[dict]) -> list[str]:
@@ -201,6 +242,37 @@ def _separation(sim, points, obs, fits: dict[str, MapFit], a: str, b: str) -> fl
     units of the noise and discrepancy floor."""
     d = fits[a].predicted - fits[b].predicted
     return float(np.nanmax(np.abs(d) / np.hypot(obs.sigma, obs.floor)))
+
+
+def _bagged(bags: dict[str, BagModel], outside_bags: list[tuple[BagModel, float]],
+            prior: dict[str, float], eta: float, settings: Settings) -> dict[str, float]:
+    """The bagged posterior (:mod:`sim_gap.bagging`) of the named hypotheses and of
+    "outside the candidates", the latter over its bases (their priors split by weight)."""
+    models = dict(bags)
+    split = {k: v for k, v in prior.items() if k != OUTSIDE}
+    for i, (bag, weight) in enumerate(outside_bags):
+        models[f"{OUTSIDE}@{i}"] = bag
+        split[f"{OUTSIDE}@{i}"] = prior[OUTSIDE] * weight
+    bagged = bagged_posterior(models, split, eta, settings.n_bags, settings.seed)
+    out = {k: bagged[k] for k in bags}
+    out[OUTSIDE] = sum(bagged[f"{OUTSIDE}@{i}"] for i in range(len(outside_bags)))
+    return out
+
+
+def _dispersion(sim: Simulated, obs, cov, fits: dict[str, MapFit],
+                evidence: dict[str, Evidence], candidate_of: dict[str, cands.Candidate]
+                ) -> float:
+    """Held-out dispersion (:func:`sim_gap.evidence.held_out_dispersion`) of the named
+    hypothesis with the largest evidence among those on the campaign's covariance (not the
+    free forms, whose covariance is apart per level), at its most probable discrepancy,
+    nugget and run soil."""
+    best = max((k for k in evidence if k != OUTSIDE
+                and cands.FREE_FORM not in candidate_of[k].laws),
+               key=lambda k: evidence[k].log_evidence)
+    f = fits[best]
+    centre, sd = param_prior(f.fit.candidate, sim.model)
+    return held_out_dispersion(cov, evidence[best].best_grid, obs.y, f.predicted, f.jac,
+                               f.internal - centre, sd, obs.point)
 
 
 def _fit_noise(points: pd.DataFrame, sig: dict[str, np.ndarray], radius_m: float
@@ -236,6 +308,8 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     fit_sig = _fit_noise(points, sig, sim.radius_m)
     single_list = cands.singles(sim.model, allowed)
     fits = _fit_all(sim, single_list, points, fit_sig, settings)
+    obs = run_soil(obs, fits["soil_only"].jac,
+                   param_prior(fits["soil_only"].fit.candidate, sim.model)[1])
     cov = covariances(obs)
     evidence = {k: _evidence(cov, obs, sim, f) for k, f in fits.items()}
     reference = _reference_laws(fits, evidence)
@@ -246,13 +320,15 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     fits.update(pair_fits)
     candidate_of = {k: f.fit.candidate for k, f in fits.items()}
     amplitudes = outside_amplitudes(sim, points, obs, single_list)
-    for key, (c, base, e) in free_forms(sim, points, obs, fits, reference, amplitudes).items():
-        candidate_of[key], fits[key], evidence[key] = c, base, e
-    evidence[OUTSIDE] = _evidence(covariances(obs, amplitudes), obs, sim, fits["soil_only"])
+    bags = {k: _bag(sim, obs, cov, None, f, evidence[k]) for k, f in fits.items()}
+    for key, (c, base, e, bag) in free_forms(sim, points, obs, fits, reference,
+                                             amplitudes).items():
+        candidate_of[key], fits[key], evidence[key], bags[key] = c, base, e, bag
+    fits[OUTSIDE], evidence[OUTSIDE], outside_bags = outside(sim, obs, amplitudes, fits,
+                                                             reference, len(allowed))
     prior = hypothesis_priors(list(candidate_of.values()), len(allowed))
-    best = max((k for k in evidence if k != OUTSIDE), key=lambda k: evidence[k].log_evidence)
-    eta = learning_rate(fits[best].fit.chi2, fits[best].fit.n_residuals, fits[best].fit.n_params)
-    probability = posterior({k: e.log_evidence for k, e in evidence.items()}, prior, eta)
+    eta = learning_rate(_dispersion(sim, obs, cov, fits, evidence, candidate_of))
+    probability = _bagged(bags, outside_bags, prior, eta, settings)
     hypotheses = sorted(
         [_hypothesis(k, candidate_of.get(k), fits.get(k, fits["soil_only"]), evidence[k],
                      prior[k], probability[k]) for k in evidence],

@@ -60,6 +60,11 @@ LENGTH_LOG_LOAD = 0.5
 TAU_GRID = np.geomspace(0.25, 128.0, 10)
 #: the nugget's size in units of the floor (module docstring)
 NUGGET_GRID = np.array([0.0, 1.0, 4.0, 16.0, 64.0])
+#: the scatter of one run's soil about the campaign's, in units of the soil prior's spread
+#: (:func:`run_soil`), equal weights: none, or a sixteenth to half the spread between
+#: published soils (one prepared bin is one soil, so its runs differ by less than two soils
+#: do; below a sixteenth the scatter is within the repeatability floor)
+RUN_SOIL_GRID = np.array([0.0, 1 / 16, 1 / 8, 1 / 4, 1 / 2])
 #: prior standard deviation of a profiled offset (a relative sinkage's unknown zero), m
 OFFSET_PRIOR_SD_M = 0.1
 
@@ -79,6 +84,7 @@ class Observations:
     kernel_shared: np.ndarray
     kernel_grouped: np.ndarray
     offsets: np.ndarray  # (entries, offsets) design, possibly zero columns
+    kernel_run: np.ndarray | None = None  # :func:`run_soil`
 
 
 def _unit_kernel(points: pd.DataFrame, point: np.ndarray, quantity: np.ndarray,
@@ -131,34 +137,54 @@ def apart_by(obs: Observations, levels: np.ndarray) -> Observations:
     return replace(obs, kernel_grouped=np.where(same, obs.kernel_shared, 0.0))
 
 
+def run_soil(obs: Observations, soil_jac: np.ndarray, soil_spread: np.ndarray
+             ) -> Observations:
+    """``obs`` with a soil state of each run: the prepared soil under one run differs from the
+    campaign's by ``d ~ N(0, (g s)^2)`` in the calibrated soil parameters (``s``: their prior
+    spread, ``g`` on :data:`RUN_SOIL_GRID`), which moves that run's drawbar pull, torque and
+    sinkage together by ``J d`` (``soil_jac``: entries x soil parameters, the base model's
+    Jacobian). The unit kernel is ``J diag(s^2) J^T`` within a point, zero between points: a
+    run-level random effect (Kennedy & O'Hagan 2001 sec. 4.2 give the model's inputs an
+    uncertainty of their own). Without it the evidence counts one run's soil three times,
+    once per quantity, and credits whichever effect moves the three as that soil does."""
+    scaled = soil_jac * soil_spread
+    same_point = obs.point[:, None] == obs.point[None, :]
+    return replace(obs, kernel_run=np.where(same_point, scaled @ scaled.T, 0.0))
+
+
 @dataclass(frozen=True)
 class Covariances:
     """The noise-plus-discrepancy covariance ``A`` of every grid point (shared amplitude x
-    outside amplitude x nugget), factored once for all candidates: ``lower`` Cholesky
+    outside amplitude x nugget x run soil), factored once for all candidates: ``lower`` Cholesky
     factors (grid points, entries, entries) and ``log_det`` of each ``A``."""
 
     lower: np.ndarray
     log_det: np.ndarray
-    shape: tuple[int, int, int]
+    shape: tuple[int, int, int, int]
 
 
 def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covariances:
-    """Factor ``A = diag(sigma^2) + offsets + t^2 K_shared + o^2 K_grouped + v^2 diag(f^2)``
-    over :data:`TAU_GRID`, ``outside`` (amplitudes of the discrepancy apart per group, floor
-    units; none by default) and :data:`NUGGET_GRID`."""
+    """Factor ``A = diag(sigma^2) + offsets + t^2 K_shared + o^2 K_grouped + v^2 diag(f^2)
+    + g^2 K_run`` over :data:`TAU_GRID`, ``outside`` (amplitudes of the discrepancy apart per
+    group, floor units; none by default), :data:`NUGGET_GRID` and, where ``obs`` has a run
+    soil kernel (:func:`run_soil`), :data:`RUN_SOIL_GRID`."""
     outside = np.zeros(1) if outside is None else np.asarray(outside, float)
+    run_grid = RUN_SOIL_GRID if obs.kernel_run is not None else np.zeros(1)
+    run_kernel = obs.kernel_run if obs.kernel_run is not None else 0.0
     base = (np.diag(obs.sigma ** 2) + OFFSET_PRIOR_SD_M ** 2 * obs.offsets @ obs.offsets.T)
     floor2 = np.diag(obs.floor ** 2)
     lower, log_det = [], []
     for t in TAU_GRID:
         for o in outside:
             for v in NUGGET_GRID:
-                factor = cholesky(base + t ** 2 * obs.kernel_shared + o ** 2 * obs.kernel_grouped
-                                  + v ** 2 * floor2, lower=True, check_finite=False)
-                lower.append(factor)
-                log_det.append(2.0 * np.sum(np.log(np.diag(factor))))
+                for g in run_grid:
+                    factor = cholesky(base + t ** 2 * obs.kernel_shared
+                                      + o ** 2 * obs.kernel_grouped + v ** 2 * floor2
+                                      + g ** 2 * run_kernel, lower=True, check_finite=False)
+                    lower.append(factor)
+                    log_det.append(2.0 * np.sum(np.log(np.diag(factor))))
     return Covariances(np.array(lower), np.array(log_det),
-                       (len(TAU_GRID), len(outside), len(NUGGET_GRID)))
+                       (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)))
 
 
 def _log_interval(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -172,18 +198,29 @@ def _log_interval(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Evidence:
-    """Log evidence (natural log) and the posterior weights of the shared discrepancy's sizes
-    (:data:`TAU_GRID`, summed over the other grids) and of the nugget's
-    (:data:`NUGGET_GRID`)."""
+    """Log evidence (natural log); the posterior weights of the shared discrepancy's sizes
+    (:data:`TAU_GRID`, summed over the other grids), of the nugget's (:data:`NUGGET_GRID`)
+    and of the run soil's (:data:`RUN_SOIL_GRID`, where the covariances have it); the most
+    probable grid point (flat index into :class:`Covariances`)."""
 
     log_evidence: float
     tau_weights: np.ndarray
     nugget_weights: np.ndarray
+    best_grid: int = 0
+    run_soil_weights: np.ndarray | None = None
+    log_at_best: float = 0.0  # the log evidence at the most probable grid point alone
 
     @property
     def nugget_rms(self) -> float:
         """Posterior root-mean-square size of the nugget (floor units)."""
         return float(np.sqrt(self.nugget_weights @ NUGGET_GRID ** 2))
+
+    @property
+    def run_soil_rms(self) -> float:
+        """Posterior root-mean-square scatter of a run's soil (soil prior spreads)."""
+        if self.run_soil_weights is None or self.run_soil_weights.size == 1:
+            return 0.0
+        return float(np.sqrt(self.run_soil_weights @ RUN_SOIL_GRID ** 2))
 
     @property
     def tau_mean(self) -> float:
@@ -238,5 +275,31 @@ def log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np
             logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)) - prior_in_box
     logs = logs.reshape(cov.shape) - np.log(logs.size)
     total = float(logsumexp(logs))
-    weights = np.exp(logsumexp(logs, axis=(1, 2)) - total)
-    return Evidence(total, weights, np.exp(logsumexp(logs, axis=(0, 1)) - total))
+    weights = np.exp(logsumexp(logs, axis=(1, 2, 3)) - total)
+    return Evidence(total, weights, np.exp(logsumexp(logs, axis=(0, 1, 3)) - total),
+                    int(np.argmax(logs)), np.exp(logsumexp(logs, axis=(0, 1, 2)) - total),
+                    float(logs.max() + np.log(logs.size)))
+
+
+def held_out_dispersion(cov: Covariances, grid: int, y: np.ndarray, predicted: np.ndarray,
+                        jac: np.ndarray, offset_from_prior: np.ndarray, prior_sd: np.ndarray,
+                        point: np.ndarray) -> float:
+    """The dispersion of a candidate's marginal model (noise, discrepancy and parameters at
+    grid point ``grid`` of ``cov``) on held-out runs: each point's entries predicted from
+    all the others, ``chi2_b = g_b^T (P_bb)^-1 g_b`` with ``P`` the inverse of the marginal
+    covariance and ``g = P r`` (the leave-one-out identities of a Gaussian; Sundararajan &
+    Keerthi 2001, Neural Computation 13:1103-1118; Rasmussen & Williams 2006, sec. 5.4.2),
+    summed over points and divided by the number of entries: 1 when the model's covariance
+    describes how its errors scatter from one run to the next, ``phi`` when they scatter
+    ``sqrt(phi)`` times wider."""
+    residual = y - np.nan_to_num(predicted, nan=0.0) + jac @ offset_from_prior
+    factor = cov.lower[grid]
+    marginal = factor @ factor.T + (jac * prior_sd ** 2) @ jac.T
+    precision = cho_solve((cholesky(marginal, lower=True, check_finite=False), True),
+                          np.eye(residual.size), check_finite=False)
+    g = precision @ residual
+    chi2 = 0.0
+    for b in np.unique(point):
+        at = np.flatnonzero(point == b)
+        chi2 += float(g[at] @ np.linalg.solve(precision[np.ix_(at, at)], g[at]))
+    return chi2 / residual.size

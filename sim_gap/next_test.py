@@ -17,7 +17,9 @@ of :mod:`sim_gap.evidence` at its MAP ``u*``:
   Kennedy & O'Hagan GP at the hypothesis' posterior-mean amplitude);
 - covariance: ``J S_post J^T`` (the parameters' Laplace posterior, ``S_post = (S^-1 +
   J_o^T A^-1 J_o)^-1``, carried through a finite-difference Jacobian ``J`` at the MAP) + the
-  noise and the nugget (its posterior RMS size) + the discrepancy's posterior covariance.
+  noise and the nugget (its posterior RMS size) + each new run's own soil (the run soil's
+  posterior RMS scatter through the soil columns of ``J``) + the discrepancy's posterior
+  covariance.
   A free-form level effect and "outside the candidates" carry their discrepancy apart per
   level (the middle of its amplitude grid): known where the campaign ran that level, fresh
   at a level (a wheel, a pass, a gravity) it has not run. A multipass or gravity level the
@@ -34,8 +36,8 @@ entropy of the labels' posterior, ``<= log2(number of labels)`` bits.
 
 The diagnosis reads its evidence at a learning rate ``eta = 1/phi`` (quasi-likelihood,
 :func:`sim_gap.decide.learning_rate`); a Gaussian likelihood to the power ``eta`` is one of
-covariance ``C / eta``, so the new runs are read the same way: a campaign the model misses by
-``sqrt(phi)`` noise widths expects less from any test.
+covariance ``C / eta``, so the new runs are read the same way: a campaign whose held-out runs
+scatter ``sqrt(phi)`` times wider than its model says expects less from any test.
 
 Only the leading hypotheses that together hold :data:`POSTERIOR_COVERED` of the posterior
 enter (renormalised). The noise of a new run is the campaign's: per quantity, the median
@@ -283,9 +285,14 @@ class _Hypothesis:
         self.groups = _levels(points, apart_by)[obs.point] if apart_by else None
         c = f.fit.candidate
         _, sd = param_prior(c, sim.model)
+        soil = np.array([p.name.startswith("soil.") for p in c.params])
+        # a new run's own soil (:func:`sim_gap.evidence.run_soil`): columns and spreads
+        self.soil, self.soil_sd = soil, e.run_soil_rms * sd[soil]
         a = (np.diag(obs.sigma ** 2 + (self.nugget * obs.floor) ** 2)
              + OFFSET_PRIOR_SD_M ** 2 * obs.offsets @ obs.offsets.T
              + self.tau ** 2 * obs.kernel_shared)
+        if obs.kernel_run is not None:
+            a += e.run_soil_rms ** 2 * obs.kernel_run
         if apart_by:
             a += self.apart_sd ** 2 * np.where(self.groups[:, None] == self.groups[None, :],
                                                obs.kernel_shared, 0.0)
@@ -338,6 +345,8 @@ def predictive(radius_m: float, points: pd.DataFrame, obs: Observations, h: _Hyp
         k_nn, k_no = h.tau ** 2 * k_nn, h.tau ** 2 * k_no
     w = solve_triangular(h.lower, k_no.T, lower=True, check_finite=False)
     cov = jac @ h.s_post @ jac.T + np.diag(noise ** 2) + k_nn - w.T @ w
+    run_soil = jac[:, h.soil] * h.soil_sd
+    cov += np.where(point[:, None] == point[None, :], run_soil @ run_soil.T, 0.0)
     mean = mean + k_no @ h.alpha
     for factor in NEW_LEVEL_FACTORS:  # a level not run: its effect can carry anything there
         if h.apart_by == factor:  # its own discrepancy apart is fresh there already

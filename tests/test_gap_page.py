@@ -31,7 +31,7 @@ from PIL import Image as PILImage
 
 import terramechanics as tm
 from campaign_report.figures import gap_curves, gap_heatmap, gap_probabilities
-from campaign_report.gap import (_folds_text, _verdict_blocks, candidate_text,
+from campaign_report.gap import (_folds_text, _verdict_blocks, candidate_text, set_text,
                                  decisive_test_text, gap_blocks, gap_page, gap_section,
                                  law_text, significant_regions, write_gap_page)
 from campaign_report.html import Heading, Image, Note
@@ -310,7 +310,7 @@ def test_inconclusive_names_the_leaders_and_never_the_outside(report):
     text = " ".join(page.text)
     assert "Verdict: inconclusive" in page.text
     sets = {s["label"]: EffectSet.from_json(s) for s in tied["effect_sets"]}
-    leaders = ", ".join(f"{candidate_text(sets[x['label']])} {cut3(x['probability'])}"
+    leaders = ", ".join(f"{set_text(sets[x['label']])} {cut3(x['probability'])}"
                         for x in tied["leaders"])
     assert f"None reaches it here; the most probable: {leaders}." in text
     assert REASON + tied["reason"] in page.text

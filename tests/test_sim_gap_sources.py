@@ -159,17 +159,18 @@ def test_ding_smooth_and_lug_wheel_on_one_soil(tmp_path):
                                                               "ding2011_lug10"]
     assert [s["wheel"]["grouser_count"] for s in d["sources"]] == [0, 30]
     assert d["wheel"]["simulated"] == "each source's own wheel"
-    # what the data give (docs/gap-report.md): the lugs add drawbar pull beyond noise, and
-    # Ding et al. model these wheels with both lug effects and slip-sinkage; soil alone loses
-    # probability against its prior (by less than Bayes' rule would say: the fits miss these
-    # points by several times their noise, so the learning rate is below one), and no named
-    # call leaves the grousers out
+    # what the data give: the lugs add drawbar pull beyond noise, and Ding et al. model these
+    # wheels with both lug effects and slip-sinkage. Soil alone loses probability against its
+    # prior, and the data raise the probability of grousers (summed over the hypotheses that
+    # hold them) above its prior. Twelve points are twelve runs, each on its own soil: part of
+    # the lugged wheel's extra pull may be its six runs' soil, so grousers need not lead, and
+    # no call that leaves them out is made
     sets = {e["label"]: e["probability"] for e in d["effect_sets"]}
     soil = next(h for h in d["hypotheses"] if h["key"] == "soil_only")
-    assert d["learning_rate"] < 1.0
+    with_lugs = [h for h in d["hypotheses"] if "grousers" in h["key"]]
     assert sets["soil_only"] < soil["prior"] / 2
+    assert sum(h["probability"] for h in with_lugs) > sum(h["prior"] for h in with_lugs)
     assert d["verdict"] in ("inconclusive", "outside_candidates") or "grousers" in d["verdict"]
-    assert d["chosen"].startswith("grousers(")
     assert d["verdict"] != "inconclusive" or d["next_tests"]
     gap.write(html_path=tmp_path / "gap.html")
     assert "grousers on ding2011_lug10 only" in (tmp_path / "gap.html").read_text()
@@ -256,9 +257,11 @@ DING_SMOOTH_CALIBRATED = ROOT / "sim_gap" / "models" / "ding2011_smooth_calibrat
 def test_ding_lug_wheel_against_a_simulation_calibrated_on_the_smooth_wheel(tmp_path):
     """The worked example "calibrated on the smooth wheel, what does the lug wheel add?"
     (docs/gap-report.md): the measured contrast (lugged minus smooth drawbar pull at the
-    lugged wheel's slips, the smooth curve interpolated) is computed here by hand; every
-    named hypothesis that leads holds grousers, soil alone is ruled out, and the call is
-    not confident (the grouser laws predict about half the measured contrast)."""
+    lugged wheel's slips, the smooth curve interpolated) is computed here by hand; the
+    leading named hypothesis holds grousers, soil alone loses probability against its prior,
+    and the call is not confident (the grouser laws predict about half the measured
+    contrast). Soil alone keeps some probability in the bagged posterior: on six lugged
+    runs, resampling the runs leaves copies whose few lugged runs the soil refit carries."""
     gap = swtlab.diagnose_gap([str(DING_POINTS)], str(DING_SMOOTH_CALIBRATED))
     d = gap.data
     assert "slip_sinkage" not in d["effect_sources"]  # the simulation has it (smooth fit)
@@ -273,7 +276,8 @@ def test_ding_lug_wheel_against_a_simulation_calibrated_on_the_smooth_wheel(tmp_
     assert dp["ci95"][0] < by_hand.mean() < dp["ci95"][1]
     assert dp["ci95"][0] > 0  # the lugs out-pull the smooth wheel beyond noise
     sets = {e["label"]: e["probability"] for e in d["effect_sets"]}
-    assert sets["soil_only"] < 0.01
+    soil = next(h for h in d["hypotheses"] if h["key"] == "soil_only")
+    assert sets["soil_only"] < soil["prior"]
     assert d["verdict"] == "inconclusive" and d["chosen"].startswith("grousers(")
     named = [e for e in d["effect_sets"] if e["label"] != "outside_candidates"]
     assert "grousers" in named[0]["effects"]

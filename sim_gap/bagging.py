@@ -1,0 +1,123 @@
+"""The bagged posterior of the hypotheses (BayesBag; Bühlmann 2014, "Discussion of Big Bayes
+Stories and BayesBag", Statistical Science 29:91-94; Huggins & Miller 2023, "Reproducible
+model selection using bagged posteriors", Bayesian Analysis 18:79-104): the posterior
+probability of each hypothesis averaged over bootstrap copies of the campaign,
+
+    P_bag(H) = (1/B) sum_b P(H | runs resampled with replacement, copy b)
+
+When every hypothesis is misspecified (another solver than the lab's wheel, laws of other
+shapes than the soil's), Bayes' rule concentrates on whichever one the particular runs
+favour, and another set of runs of the same campaign may favour another: its probabilities
+are neither reproducible nor calibrated. The bagged posterior is stable under resampling
+of the runs, and concentrates on one hypothesis only where the runs agree on it; where the
+models are right it agrees with Bayes' rule (Huggins & Miller, Theorems 1-3).
+
+Each copy resamples the campaign's runs (points) with replacement; a run drawn ``m``
+times counts as the mean of ``m`` runs at its condition (:func:`_copy`). Each hypothesis'
+evidence on a copy is the linearised Laplace evidence of
+:func:`sim_gap.evidence.log_evidence` at its most probable discrepancy, nugget and run-soil
+sizes on the whole campaign (type-II; the sizes are not refitted per copy), plus the Occam
+factor of those sizes on the whole campaign, with the same truncated priors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim_gap.evidence import (NUGGET_GRID, OFFSET_PRIOR_SD_M, RUN_SOIL_GRID, TAU_GRID,
+                              Covariances, Observations, log_evidence)
+from sim_gap.decide import posterior
+
+#: bootstrap copies: the Monte Carlo error of a probability near the 0.9 of a call is then
+#: about sqrt(0.9 x 0.1 / 200) = 0.02
+N_BAGS = 200
+
+
+@dataclass(frozen=True)
+class BagModel:
+    """What one hypothesis' evidence on a copy needs: its observations (their kernels), the
+    sizes of its covariance (``grid``: shared, outside, nugget, run soil, in floor or
+    soil-spread units), its MAP prediction, Jacobian, offset from the prior centre, prior
+    standard deviations and bounds (internal coordinates, from the prior centre), and the
+    Occam factor of those sizes on the whole campaign (``log Z - log Z(grid)``: what
+    integrating over the sizes costs against fixing them at their best; a hypothesis with
+    an extra discrepancy pays for its flexibility on every copy as it does on the
+    campaign)."""
+
+    obs: Observations
+    grid: tuple[float, float, float, float]
+    predicted: np.ndarray
+    jac: np.ndarray
+    offset: np.ndarray
+    sd: np.ndarray
+    bounds: tuple[np.ndarray, np.ndarray]
+    occam: float
+
+
+def grid_values(cov: Covariances, outside: np.ndarray | None, flat: int
+                ) -> tuple[float, float, float, float]:
+    """The sizes at flat grid index ``flat`` of ``cov`` (:func:`sim_gap.evidence.covariances`
+    with amplitudes ``outside``)."""
+    t, o, v, g = np.unravel_index(flat, cov.shape)
+    out = np.zeros(1) if outside is None else np.asarray(outside, float)
+    run = RUN_SOIL_GRID if cov.shape[3] > 1 else np.zeros(1)
+    return float(TAU_GRID[t]), float(out[o]), float(NUGGET_GRID[v]), float(run[g])
+
+
+def _copy(obs: Observations, take: np.ndarray, times: np.ndarray,
+          grid: tuple[float, float, float, float]) -> np.ndarray:
+    """The covariance of the entries ``take`` of ``obs`` in a copy that draws each ``times``
+    times: a run drawn ``m`` times counts as the mean of ``m`` runs at its condition, so its
+    noise, nugget and soil (its own, independent from run to run) are divided by ``m`` and
+    the discrepancies (of the condition) are not. Its copies' zero scatter is an artefact of
+    resampling, not evidence of a small noise."""
+    t, o, v, g = grid
+    ix = np.ix_(take, take)
+    a = (t ** 2 * obs.kernel_shared[ix] + o ** 2 * obs.kernel_grouped[ix]
+         + np.diag((obs.sigma[take] ** 2 + (v * obs.floor[take]) ** 2) / times)
+         + OFFSET_PRIOR_SD_M ** 2 * obs.offsets[take] @ obs.offsets[take].T)
+    if obs.kernel_run is not None and g > 0:
+        a += g ** 2 * obs.kernel_run[ix] / times[:, None]
+    return a
+
+
+def _factor(a: np.ndarray) -> Covariances:
+    lower = np.linalg.cholesky(a)
+    return Covariances(lower[None], np.array([2.0 * np.sum(np.log(np.diag(lower)))]),
+                       (1, 1, 1, 1))
+
+
+def resample(point: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The entries of the points a bootstrap copy draws (``counts[p]`` times point ``p``)
+    and how many times each entry's point was drawn."""
+    take = np.flatnonzero(counts[point] > 0)
+    return take, counts[point[take]].astype(float)
+
+
+def bagged_posterior(models: dict[str, BagModel], prior: dict[str, float], eta: float,
+                     n_bags: int = N_BAGS, seed: int = 0) -> dict[str, float]:
+    """``P_bag`` of every key of ``models`` (module docstring) with priors ``prior`` and
+    learning rate ``eta``. Every model's observations hold the same entries (the campaign's)."""
+    rng = np.random.default_rng(seed)
+    keys = list(models)
+    point = models[keys[0]].obs.point
+    n_points = int(point.max()) + 1
+    total = dict.fromkeys(keys, 0.0)
+    for _ in range(n_bags):
+        take, times = resample(point, rng.multinomial(n_points,
+                                                      np.full(n_points, 1 / n_points)))
+        factors: dict[tuple, Covariances] = {}
+        logs = {}
+        for key in keys:
+            m = models[key]
+            cache = (id(m.obs), m.grid)
+            if cache not in factors:
+                factors[cache] = _factor(_copy(m.obs, take, times, m.grid))
+            logs[key] = m.occam + log_evidence(factors[cache], m.obs.y[take],
+                                               m.predicted[take], m.jac[take], m.offset,
+                                               m.sd, m.bounds).log_evidence
+        for key, p in posterior(logs, prior, eta).items():
+            total[key] += p / n_bags
+    return total
