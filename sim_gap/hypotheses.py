@@ -13,16 +13,24 @@ Parameter priors (Gaussian in the fitted coordinates, log for the moduli):
   published range).
 
 Effect-set priors: each effect that the campaign can carry (:func:`admissible`) is present
-independently with probability :data:`P_EFFECT`, a stated prior (the bench issue calibrates
-the probabilities it gives). Sets of three or more effects are not enumerated; their prior
-mass goes to the hypothesis "outside the candidates", together with :data:`P_OTHER_EFFECT`,
-the stated prior that an effect not in the vocabulary is at work. Within an effect set the
-prior is split equally over the law assignments fitted, so a family with more laws gets no
-more prior mass.
+with one unknown probability ``p`` shared by them, uniform on [0, 1]; integrated over ``p``,
+a set of ``k`` of the ``n`` admissible effects has prior ``k! (n - k)! / (n + 1)!``: every
+number of missing effects, 0 to ``n``, is equally likely, and the sets of one size share
+its mass (Scott & Berger 2010, "Bayes and empirical-Bayes multiplicity adjustment in the
+variable-selection problem", Ann. Statist. 38:2587-2619: the beta-binomial prior, which
+adjusts for the number of candidates instead of fixing each effect's chance). A lab
+diagnoses a gap because it does not know how many effects the simulation lacks; a fixed
+chance per effect would decide that for it (0.25 per effect puts 42 % on "none" among three
+effects, where the uniform size prior puts 25 %). Sets of three or more effects are not
+enumerated; their prior mass goes to the hypothesis "outside the candidates", together
+with :data:`P_OTHER_EFFECT`, the stated prior that an effect not in the vocabulary is at
+work. Within an effect set the prior is split equally over the law assignments fitted, so
+a family with more laws gets no more prior mass.
 """
 
 from __future__ import annotations
 
+import math
 from itertools import combinations
 
 import numpy as np
@@ -32,8 +40,6 @@ import terramechanics as tm
 from sim_gap.candidates import Candidate
 from sim_gap.priors import soil_prior
 
-#: prior probability that one admissible effect is at work in a campaign
-P_EFFECT = 0.25
 #: prior probability that an effect outside the vocabulary is at work
 P_OTHER_EFFECT = 0.1
 #: the key of the hypothesis "an effect outside the candidates (or more than two)"
@@ -88,7 +94,8 @@ def admissible(effects: list[str], points: pd.DataFrame) -> tuple[list[str], dic
 def set_prior(effects: tuple[str, ...], n_admissible: int) -> float:
     """Prior probability of exactly the effect set ``effects`` among ``n_admissible``."""
     k = len(effects)
-    return P_EFFECT ** k * (1.0 - P_EFFECT) ** (n_admissible - k) * (1.0 - P_OTHER_EFFECT)
+    return ((1.0 - P_OTHER_EFFECT) * math.factorial(k) * math.factorial(n_admissible - k)
+            / math.factorial(n_admissible + 1))
 
 
 def outside_prior(n_admissible: int) -> float:
