@@ -373,14 +373,14 @@ def test_reliability_bins_count_each_campaign_once():
         np.linspace(0.3, 1.0, 30)) if p >= 0.9]))
 
 
-@pytest.mark.slow  # three campaigns through swtlab process and swtlab gap: about half a minute idle
+@pytest.mark.slow  # two campaigns through swtlab process and swtlab gap: about 45 s idle
 def test_calibration_bench_runs_the_full_chain_on_a_subset(tmp_path):
-    """Plumbing of ``python -m bench gap_calibration`` on three campaigns of a seed kept for
+    """Plumbing of ``python -m bench gap_calibration`` on two campaigns of a seed kept for
     this test (9001): every campaign written, processed, diagnosed and scored."""
     from bench.bench_gap_calibration import run
 
-    result = run(tmp_path, (9001,), 3, jobs=1)
-    assert result["n"] == 3
+    result = run(tmp_path, (9001,), 2, jobs=1)
+    assert result["n"] == 2
     assert all(r["outcome"] != "failed" for r in result["campaigns"]), result["campaigns"]
-    assert sum(b["n"] for b in result["calibration"]["bins"]) == 3
+    assert sum(b["n"] for b in result["calibration"]["bins"]) == 2
     assert all(0.0 <= r["p_true"] <= 1.0 for r in result["campaigns"])
