@@ -15,7 +15,7 @@ models are right it agrees with Bayes' rule (Huggins & Miller, Theorems 1-3).
 Each copy resamples the campaign's runs (points) with replacement; a run drawn ``m``
 times counts as the mean of ``m`` runs at its condition (:func:`_copy`). Each hypothesis'
 evidence on a copy is the linearised Laplace evidence of
-:func:`sim_gap.evidence.log_evidence` at its most probable discrepancy, nugget and run-soil
+:func:`sim_gap.evidence.grid_log_evidence` at its most probable discrepancy, nugget and run-soil
 sizes on the whole campaign (type-II; the sizes are not refitted per copy), plus the Occam
 factor of those sizes on the whole campaign, with the same truncated priors.
 """
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim_gap.evidence import (NUGGET_GRID, OFFSET_PRIOR_SD_M, RUN_SOIL_GRID, TAU_GRID,
-                              Covariances, Observations, log_evidence)
+                              Covariances, Observations, grid_log_evidence)
 from sim_gap.decide import posterior
 
 #: bootstrap copies: the Monte Carlo error of a probability near the 0.9 of a call is then
@@ -115,9 +115,9 @@ def bagged_posterior(models: dict[str, BagModel], prior: dict[str, float], eta: 
             cache = (id(m.obs), m.grid)
             if cache not in factors:
                 factors[cache] = _factor(_copy(m.obs, take, times, m.grid))
-            logs[key] = m.occam + log_evidence(factors[cache], m.obs.y[take],
-                                               m.predicted[take], m.jac[take], m.offset,
-                                               m.sd, m.bounds).log_evidence
+            logs[key] = m.occam + float(grid_log_evidence(
+                factors[cache], m.obs.y[take], m.predicted[take], m.jac[take], m.offset,
+                m.sd, m.bounds)[0])
         for key, p in posterior(logs, prior, eta).items():
             total[key] += p / n_bags
     return total

@@ -231,10 +231,26 @@ class Evidence:
 def log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np.ndarray,
                  offset_from_prior: np.ndarray, prior_sd: np.ndarray,
                  bounds_from_prior: tuple[np.ndarray, np.ndarray] | None = None) -> Evidence:
-    """The linearised-Laplace log evidence of a candidate whose MAP predicts ``predicted``
-    (flat, the entries ``y``) with Jacobian ``jac`` (entries x parameters, internal
-    coordinates), ``offset_from_prior = u* - mu`` and prior standard deviations
-    ``prior_sd``, integrated over the grids of ``cov`` (:func:`covariances`).
+    """The linearised-Laplace log evidence of a candidate (:func:`grid_log_evidence`)
+    integrated over the grids of ``cov`` (:func:`covariances`), equal weights."""
+    logs = grid_log_evidence(cov, y, predicted, jac, offset_from_prior, prior_sd,
+                             bounds_from_prior)
+    logs = logs.reshape(cov.shape) - np.log(logs.size)
+    total = float(logsumexp(logs))
+    weights = np.exp(logsumexp(logs, axis=(1, 2, 3)) - total)
+    return Evidence(total, weights, np.exp(logsumexp(logs, axis=(0, 1, 3)) - total),
+                    int(np.argmax(logs)), np.exp(logsumexp(logs, axis=(0, 1, 2)) - total),
+                    float(logs.max() + np.log(logs.size)))
+
+
+def grid_log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np.ndarray,
+                      offset_from_prior: np.ndarray, prior_sd: np.ndarray,
+                      bounds_from_prior: tuple[np.ndarray, np.ndarray] | None = None
+                      ) -> np.ndarray:
+    """The linearised-Laplace log evidence at each grid point of ``cov`` (flat) of a
+    candidate whose MAP predicts ``predicted`` (flat, the entries ``y``) with Jacobian ``jac``
+    (entries x parameters, internal coordinates), ``offset_from_prior = u* - mu`` and prior
+    standard deviations ``prior_sd``.
 
     With ``v = u - mu ~ N(0, S)`` the residual ``r = y - eta* + J (u* - mu) = J v + e``,
     ``e ~ N(0, A)``, and by Woodbury's identity and the determinant lemma, with
@@ -273,12 +289,7 @@ def log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, jac: np
             post_cov = cho_solve((m_factor, True), np.eye(b.size), check_finite=False)
             mean, sd = post_cov @ b, np.sqrt(np.diag(post_cov))
             logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)) - prior_in_box
-    logs = logs.reshape(cov.shape) - np.log(logs.size)
-    total = float(logsumexp(logs))
-    weights = np.exp(logsumexp(logs, axis=(1, 2, 3)) - total)
-    return Evidence(total, weights, np.exp(logsumexp(logs, axis=(0, 1, 3)) - total),
-                    int(np.argmax(logs)), np.exp(logsumexp(logs, axis=(0, 1, 2)) - total),
-                    float(logs.max() + np.log(logs.size)))
+    return logs
 
 
 def held_out_dispersion(cov: Covariances, grid: int, y: np.ndarray, predicted: np.ndarray,
