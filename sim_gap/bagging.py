@@ -13,7 +13,8 @@ of the runs, and concentrates on one hypothesis only where the runs agree on it;
 models are right it agrees with Bayes' rule (Huggins & Miller, Theorems 1-3).
 
 Each copy resamples the campaign's runs (points) with replacement; a run drawn ``m``
-times counts as the mean of ``m`` runs at its condition (:func:`_copy`). Each hypothesis'
+times counts as the mean of ``m`` runs at its condition
+(:func:`sim_gap.evidence.covariance_at`). Each hypothesis'
 evidence on a copy is the linearised Laplace evidence of
 :func:`sim_gap.evidence.grid_log_evidence` at its most probable discrepancy, nugget and run-soil
 sizes on the whole campaign (type-II; the sizes are not refitted per copy), plus the Occam
@@ -26,8 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_gap.evidence import (NUGGET_GRID, OFFSET_PRIOR_SD_M, RUN_SOIL_GRID, TAU_GRID,
-                              Covariances, Observations, grid_log_evidence)
+from sim_gap.evidence import Covariances, Observations, covariance_at, grid_log_evidence
 from sim_gap.decide import posterior
 
 #: bootstrap copies: the Monte Carlo error of a probability near the 0.9 of a call is then
@@ -47,7 +47,7 @@ class BagModel:
     campaign)."""
 
     obs: Observations
-    grid: tuple[float, float, float, float]
+    grid: tuple[float, ...]
     predicted: np.ndarray
     jac: np.ndarray
     offset: np.ndarray
@@ -56,37 +56,10 @@ class BagModel:
     occam: float
 
 
-def grid_values(cov: Covariances, outside: np.ndarray | None, flat: int
-                ) -> tuple[float, float, float, float]:
-    """The sizes at flat grid index ``flat`` of ``cov`` (:func:`sim_gap.evidence.covariances`
-    with amplitudes ``outside``)."""
-    t, o, v, g = np.unravel_index(flat, cov.shape)
-    out = np.zeros(1) if outside is None else np.asarray(outside, float)
-    run = RUN_SOIL_GRID if cov.shape[3] > 1 else np.zeros(1)
-    return float(TAU_GRID[t]), float(out[o]), float(NUGGET_GRID[v]), float(run[g])
-
-
-def _copy(obs: Observations, take: np.ndarray, times: np.ndarray,
-          grid: tuple[float, float, float, float]) -> np.ndarray:
-    """The covariance of the entries ``take`` of ``obs`` in a copy that draws each ``times``
-    times: a run drawn ``m`` times counts as the mean of ``m`` runs at its condition, so its
-    noise, nugget and soil (its own, independent from run to run) are divided by ``m`` and
-    the discrepancies (of the condition) are not. Its copies' zero scatter is an artefact of
-    resampling, not evidence of a small noise."""
-    t, o, v, g = grid
-    ix = np.ix_(take, take)
-    a = (t ** 2 * obs.kernel_shared[ix] + o ** 2 * obs.kernel_grouped[ix]
-         + np.diag((obs.sigma[take] ** 2 + (v * obs.floor[take]) ** 2) / times)
-         + OFFSET_PRIOR_SD_M ** 2 * obs.offsets[take] @ obs.offsets[take].T)
-    if obs.kernel_run is not None and g > 0:
-        a += g ** 2 * obs.kernel_run[ix] / times[:, None]
-    return a
-
-
 def _factor(a: np.ndarray) -> Covariances:
     lower = np.linalg.cholesky(a)
     return Covariances(lower[None], np.array([2.0 * np.sum(np.log(np.diag(lower)))]),
-                       (1, 1, 1, 1))
+                       (1, 1, 1, 1), np.zeros((1, 4)))
 
 
 def resample(point: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -114,7 +87,7 @@ def bagged_posterior(models: dict[str, BagModel], prior: dict[str, float], eta: 
             m = models[key]
             cache = (id(m.obs), m.grid)
             if cache not in factors:
-                factors[cache] = _factor(_copy(m.obs, take, times, m.grid))
+                factors[cache] = _factor(covariance_at(m.obs, m.grid, take, times))
             logs[key] = m.occam + float(grid_log_evidence(
                 factors[cache], m.obs.y[take], m.predicted[take], m.jac[take], m.offset,
                 m.sd, m.bounds)[0])

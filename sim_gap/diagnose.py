@@ -16,7 +16,7 @@ from threadpoolctl import threadpool_limits
 
 
 from sim_gap import candidates as cands
-from sim_gap.bagging import N_BAGS, BagModel, bagged_posterior, grid_values
+from sim_gap.bagging import N_BAGS, BagModel, bagged_posterior
 from sim_gap.crossval import contrasts, cross_validate, folds
 from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate
 from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances, held_out_dispersion,
@@ -167,13 +167,12 @@ def _levels(points: pd.DataFrame, effect: str) -> np.ndarray | None:
     return levels if len(set(levels.tolist())) >= 2 else None
 
 
-def _bag(sim: Simulated, obs, cov, amplitudes: np.ndarray | None, f: MapFit, e: Evidence
-         ) -> BagModel:
+def _bag(sim: Simulated, obs, cov, f: MapFit, e: Evidence) -> BagModel:
     """What the bagged posterior needs of hypothesis fit ``f`` with evidence ``e`` on the
     covariances ``cov`` of ``obs`` (:mod:`sim_gap.bagging`)."""
     centre, sd = param_prior(f.fit.candidate, sim.model)
     lo, hi = internal_bounds(f.fit.candidate)
-    return BagModel(obs, grid_values(cov, amplitudes, e.best_grid), f.predicted, f.jac,
+    return BagModel(obs, tuple(map(float, cov.sizes[e.best_grid])), f.predicted, f.jac,
                     f.internal - centre, sd, (lo - centre, hi - centre),
                     e.log_evidence - e.log_at_best)
 
@@ -199,7 +198,7 @@ def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit
         for base in bases:
             c = cands.with_free_form(base.fit.candidate, effect)
             e = _evidence(cov, obs, sim, base)
-            out[c.key] = (c, base, e, _bag(sim, apart, cov, amplitudes, base, e))
+            out[c.key] = (c, base, e, _bag(sim, apart, cov, base, e))
     return out
 
 
@@ -221,7 +220,7 @@ def outside(sim: Simulated, obs, amplitudes: np.ndarray, fits: dict[str, MapFit]
     log_weight -= logsumexp(log_weight)
     terms = log_weight + np.array([e.log_evidence for e in each])
     best = int(np.argmax(terms))
-    bags = [(_bag(sim, obs, cov, amplitudes, f, e), float(np.exp(w)))
+    bags = [(_bag(sim, obs, cov, f, e), float(np.exp(w)))
             for f, e, w in zip(bases, each, log_weight)]
     return bases[best], replace(each[best], log_evidence=float(logsumexp(terms))), bags
 
@@ -320,7 +319,7 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     fits.update(pair_fits)
     candidate_of = {k: f.fit.candidate for k, f in fits.items()}
     amplitudes = outside_amplitudes(sim, points, obs, single_list)
-    bags = {k: _bag(sim, obs, cov, None, f, evidence[k]) for k, f in fits.items()}
+    bags = {k: _bag(sim, obs, cov, f, evidence[k]) for k, f in fits.items()}
     for key, (c, base, e, bag) in free_forms(sim, points, obs, fits, reference,
                                              amplitudes).items():
         candidate_of[key], fits[key], evidence[key], bags[key] = c, base, e, bag

@@ -41,6 +41,8 @@ discrepancy cannot bend to is read as evidence for whichever effect bends the cu
 
 from __future__ import annotations
 
+import itertools
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -156,35 +158,49 @@ def run_soil(obs: Observations, soil_jac: np.ndarray, soil_spread: np.ndarray
 class Covariances:
     """The noise-plus-discrepancy covariance ``A`` of every grid point (shared amplitude x
     outside amplitude x nugget x run soil), factored once for all candidates: ``lower`` Cholesky
-    factors (grid points, entries, entries) and ``log_det`` of each ``A``."""
+    factors (grid points, entries, entries), ``log_det`` of each ``A`` and the ``sizes``
+    (shared, outside, nugget, run soil) of each grid point (:func:`covariance_at`)."""
 
     lower: np.ndarray
     log_det: np.ndarray
     shape: tuple[int, int, int, int]
+    sizes: np.ndarray  # (grid points, 4)
+
+
+def covariance_at(obs: Observations, sizes: Sequence[float], take: np.ndarray | None = None,
+                  times: np.ndarray | None = None) -> np.ndarray:
+    """``A = diag(sigma^2) + offsets + t^2 K_shared + o^2 K_grouped + v^2 diag(f^2)
+    + g^2 K_run`` at ``sizes = (t, o, v, g)``, over the entries ``take`` (default: all).
+    ``times``: how often each entry's run is drawn in a bootstrap copy
+    (:mod:`sim_gap.bagging`); a run drawn ``m`` times counts as the mean of ``m`` runs at its
+    condition, so its noise, nugget and soil (its own, independent from run to run) are
+    divided by ``m`` and the discrepancies (of the condition) are not."""
+    t, o, v, g = sizes
+    if take is None:
+        take = np.arange(obs.y.size)
+    per_run = np.ones(take.size) if times is None else times
+    ix = np.ix_(take, take)
+    offsets = obs.offsets[take]
+    a = (np.diag(obs.sigma[take] ** 2 / per_run) + OFFSET_PRIOR_SD_M ** 2 * offsets @ offsets.T
+         + t ** 2 * obs.kernel_shared[ix] + o ** 2 * obs.kernel_grouped[ix]
+         + v ** 2 * np.diag(obs.floor[take] ** 2 / per_run))
+    if obs.kernel_run is not None and g > 0:
+        a += g ** 2 * obs.kernel_run[ix] / per_run[:, None]
+    return a
 
 
 def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covariances:
-    """Factor ``A = diag(sigma^2) + offsets + t^2 K_shared + o^2 K_grouped + v^2 diag(f^2)
-    + g^2 K_run`` over :data:`TAU_GRID`, ``outside`` (amplitudes of the discrepancy apart per
-    group, floor units; none by default), :data:`NUGGET_GRID` and, where ``obs`` has a run
-    soil kernel (:func:`run_soil`), :data:`RUN_SOIL_GRID`."""
+    """Factor :func:`covariance_at` over :data:`TAU_GRID`, ``outside`` (amplitudes of the
+    discrepancy apart per group, floor units; none by default), :data:`NUGGET_GRID` and,
+    where ``obs`` has a run soil kernel (:func:`run_soil`), :data:`RUN_SOIL_GRID`."""
     outside = np.zeros(1) if outside is None else np.asarray(outside, float)
     run_grid = RUN_SOIL_GRID if obs.kernel_run is not None else np.zeros(1)
-    run_kernel = obs.kernel_run if obs.kernel_run is not None else 0.0
-    base = (np.diag(obs.sigma ** 2) + OFFSET_PRIOR_SD_M ** 2 * obs.offsets @ obs.offsets.T)
-    floor2 = np.diag(obs.floor ** 2)
-    lower, log_det = [], []
-    for t in TAU_GRID:
-        for o in outside:
-            for v in NUGGET_GRID:
-                for g in run_grid:
-                    factor = cholesky(base + t ** 2 * obs.kernel_shared
-                                      + o ** 2 * obs.kernel_grouped + v ** 2 * floor2
-                                      + g ** 2 * run_kernel, lower=True, check_finite=False)
-                    lower.append(factor)
-                    log_det.append(2.0 * np.sum(np.log(np.diag(factor))))
-    return Covariances(np.array(lower), np.array(log_det),
-                       (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)))
+    sizes = np.array(list(itertools.product(TAU_GRID, outside, NUGGET_GRID, run_grid)))
+    lower = np.array([cholesky(covariance_at(obs, s), lower=True, check_finite=False)
+                      for s in sizes])
+    log_det = 2.0 * np.sum(np.log(np.diagonal(lower, axis1=1, axis2=2)), axis=1)
+    return Covariances(lower, log_det,
+                       (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)), sizes)
 
 
 def _log_interval(a: np.ndarray, b: np.ndarray) -> np.ndarray:

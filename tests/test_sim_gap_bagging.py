@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim_gap.bagging import BagModel, _copy, bagged_posterior, resample
+from sim_gap.bagging import BagModel, bagged_posterior, resample
 from sim_gap.decide import posterior
-from sim_gap.evidence import Observations, covariances, log_evidence
+from sim_gap.evidence import Observations, covariance_at, covariances, log_evidence
 
 GRID = (0.0, 0.0, 0.0, 0.0)
 
@@ -32,7 +32,7 @@ def test_a_run_drawn_m_times_is_the_mean_of_m_runs():
     take, times = resample(obs.point, np.array([0, 2, 1]))
     assert take.tolist() == [1, 2] and times.tolist() == [2.0, 1.0]
     tau, nugget = 1.5, 2.0
-    got = _copy(obs, take, times, (tau, 0.0, nugget, 0.0))
+    got = covariance_at(obs, (tau, 0.0, nugget, 0.0), take, times)
     noise = 0.3 ** 2 + (nugget * 0.1) ** 2
     expected = tau ** 2 * obs.kernel_shared[np.ix_(take, take)] + np.diag([noise / 2, noise])
     np.testing.assert_allclose(got, expected)
