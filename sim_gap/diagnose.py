@@ -177,6 +177,14 @@ def _bag(sim: Simulated, obs, cov, f: MapFit, e: Evidence) -> BagModel:
                     e.log_evidence - e.log_at_best)
 
 
+def _bases(fits: dict[str, MapFit], reference: dict[str, str], leaving_out: str | None = None
+           ) -> list[MapFit]:
+    """Soil recalibration alone and each candidate effect under its reference law (but
+    ``leaving_out``): what a free-form effect or an effect outside the candidates acts on."""
+    return [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()
+                                  if e != leaving_out]
+
+
 def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit],
                reference: dict[str, str], amplitudes: np.ndarray
                ) -> dict[str, tuple[cands.Candidate, MapFit, Evidence, BagModel]]:
@@ -193,9 +201,7 @@ def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit
             continue
         apart = apart_by(obs, levels)
         cov = covariances(apart, amplitudes)
-        bases = [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()
-                                       if e != effect]
-        for base in bases:
+        for base in _bases(fits, reference, leaving_out=effect):
             c = cands.with_free_form(base.fit.candidate, effect)
             e = _evidence(cov, obs, sim, base)
             out[c.key] = (c, base, e, _bag(sim, apart, cov, base, e))
@@ -214,7 +220,7 @@ def outside(sim: Simulated, obs, amplitudes: np.ndarray, fits: dict[str, MapFit]
     the most probable base's fit, the mixture's evidence (with that base's discrepancy
     sizes) and each base's bagging model with its weight."""
     cov = covariances(obs, amplitudes)
-    bases = [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()]
+    bases = _bases(fits, reference)
     each = [_evidence(cov, obs, sim, f) for f in bases]
     log_weight = np.log([set_prior(f.fit.candidate.effects, n_admissible) for f in bases])
     log_weight -= logsumexp(log_weight)
