@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import beta
 
+from testbeds.apart.detectability import TELLABLE_D, effect_distances, tellable
 from testbeds.apart.effects import SIX
 
 CLASSES = ("none", "single", "pair", "outside")
@@ -201,8 +202,9 @@ def calibration(rows: list[dict]) -> dict:
     n = len(rows)
     wrong = sum(r["outcome"] == "wrong" for r in rows)
 
-    def rate(cls, outcome):
-        sub = [r for r in rows if r["class"] in cls]
+    def rate(cls, outcome, tellable_only=False):
+        sub = [r for r in rows if r["class"] in cls
+               and (r.get("tellable", True) or not tellable_only)]
         return (sum(r["outcome"] == outcome for r in sub), len(sub))
 
     p_true = np.array([r["p_true"] for r in scored], float)
@@ -211,15 +213,26 @@ def calibration(rows: list[dict]) -> dict:
             "confident_wrong_upper_95": upper_95(wrong, n),
             "right_none_and_singles": rate(("none", "single"), "right"),
             "right_pairs": rate(("pair",), "right"),
+            "right_none_and_singles_tellable": rate(("none", "single"), "right", True),
+            "right_pairs_tellable": rate(("pair",), "right", True),
+            "untellable": [{"campaign": r["campaign"], "distances": r["distances"]}
+                           for r in rows if not r.get("tellable", True)],
             "outside_not_named": rate(("outside",), "right")}
 
 
 def score(out: Path) -> dict:
-    """Rows of every campaign with a truth file under ``out`` and the counts per class."""
-    rows = [score_campaign(out / path.stem, json.loads(path.read_text()))
-            for path in sorted((out / "truth").glob("c*.json"))]
-    for r in rows:
-        r["campaign"] = f"{out.name}/{r['campaign']}"
+    """Rows of every campaign with a truth file under ``out`` and the counts per class; a
+    campaign of one or two of the six also gets each effect's oracle distance and whether its
+    design can tell every effect from its absence (:mod:`testbeds.apart.detectability`)."""
+    rows = []
+    for path in sorted((out / "truth").glob("c*.json")):
+        truth = json.loads(path.read_text())
+        row = score_campaign(out / path.stem, truth)
+        row["campaign"] = f"{out.name}/{row['campaign']}"
+        if truth["class"] in ("single", "pair"):
+            row["distances"] = effect_distances(truth["seed"], truth["index"])
+            row["tellable"] = tellable(row["distances"])
+        rows.append(row)
     return summarise(rows)
 
 
@@ -278,8 +291,19 @@ def calibration_markdown(cal: dict) -> str:
               f"{cal['log_loss']:.2f}" if cal["log_loss"] is not None else "- no probabilities",
               f"- right on none and singles: {frac(cal['right_none_and_singles'])}",
               f"- right on pairs: {frac(cal['right_pairs'])}",
+              f"- the same where the design can tell each effect from its absence "
+              f"(testbeds.apart.detectability): none and singles "
+              f"{frac(cal['right_none_and_singles_tellable'])}, pairs "
+              f"{frac(cal['right_pairs_tellable'])}",
               f"- an effect outside the six not named as one of the six: "
               f"{frac(cal['outside_not_named'])}"]
+    if cal["untellable"]:
+        lines += ["", "Campaigns whose design cannot tell an effect from its absence (an oracle "
+                  f"that knows the truth's laws expects less than 2 ln 9 = {TELLABLE_D:.2f} of "
+                  "evidence; each effect's distance D):", ""]
+        lines += [f"- {u['campaign']}: " + ", ".join(f"{e} {d:.1f}"
+                                                     for e, d in u["distances"].items())
+                  for u in cal["untellable"]]
     return "\n".join(lines)
 
 
