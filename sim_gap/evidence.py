@@ -47,7 +47,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from scipy.linalg import cho_solve, cholesky, solve_triangular
+from scipy.linalg import cho_solve, cholesky
+from scipy.linalg.lapack import dpotrf, dpotrs, dtrtrs
 from scipy.special import log_ndtr, logsumexp
 
 from sim_gap.fit import independent_entries, quantities_of
@@ -291,21 +292,35 @@ def grid_log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, ja
         lo, hi = bounds_from_prior
         prior_in_box = np.sum(_log_interval(lo / prior_sd, hi / prior_sd))
     logs = np.empty(cov.log_det.size)
+    prior_precision = np.diag(1.0 / prior_var)
     for g, (factor, log_det) in enumerate(zip(cov.lower, cov.log_det)):
-        x = solve_triangular(factor, rhs, lower=True, check_finite=False)
+        x = _lapack(dtrtrs, factor, rhs, lower=1)
         xr, xj = x[:, 0], x[:, 1:]
         b = xj.T @ xr
-        m = np.diag(1.0 / prior_var) + xj.T @ xj
-        m_factor = cholesky(m, lower=True, check_finite=False)
-        w = solve_triangular(m_factor, b, lower=True, check_finite=False)
+        m_factor = _lapack(dpotrf, prior_precision + xj.T @ xj, lower=1, clean=1)
+        w = _lapack(dtrtrs, m_factor, b, lower=1)
         logs[g] = (-0.5 * (xr @ xr - w @ w) - 0.5 * log_det
-                   - 0.5 * (np.sum(np.log(prior_var)) + 2.0 * np.sum(np.log(np.diag(
+                   - 0.5 * (np.sum(np.log(prior_var)) + 2.0 * np.sum(np.log(np.diagonal(
                        m_factor)))) - 0.5 * residual.size * np.log(2.0 * np.pi))
         if bounds_from_prior is not None:
-            post_cov = cho_solve((m_factor, True), np.eye(b.size), check_finite=False)
-            mean, sd = post_cov @ b, np.sqrt(np.diag(post_cov))
+            post_cov = _lapack(dpotrs, m_factor, np.eye(b.size), lower=1)
+            mean, sd = post_cov @ b, np.sqrt(np.diagonal(post_cov))
             logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)) - prior_in_box
     return logs
+
+
+def _lapack(routine, *args, **options) -> np.ndarray:
+    """The result of a LAPACK routine of :mod:`scipy.linalg.lapack` (Cholesky factor,
+    triangular solve, solve with a Cholesky factor), raising on failure: the evidence
+    calls these thousands of times per diagnosis on small matrices, where the wrappers of
+    :mod:`scipy.linalg` cost more than the arithmetic. A hypothesis without parameters has
+    empty matrices, which LAPACK refuses: their result is the empty right-hand side."""
+    if args[0].size == 0:
+        return args[-1]
+    out, info = routine(*args, **options)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"{routine.__name__}: LAPACK info {info}")
+    return out
 
 
 def held_out_dispersion(cov: Covariances, grid: int, y: np.ndarray, predicted: np.ndarray,
