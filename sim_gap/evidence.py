@@ -176,18 +176,45 @@ def covariance_at(obs: Observations, sizes: Sequence[float], take: np.ndarray | 
     (:mod:`sim_gap.bagging`); a run drawn ``m`` times counts as the mean of ``m`` runs at its
     condition, so its noise, nugget and soil (its own, independent from run to run) are
     divided by ``m`` and the discrepancies (of the condition) are not."""
-    t, o, v, g = sizes
-    if take is None:
-        take = np.arange(obs.y.size)
-    per_run = np.ones(take.size) if times is None else times
-    ix = np.ix_(take, take)
-    offsets = obs.offsets[take]
-    a = (np.diag(obs.sigma[take] ** 2 / per_run) + OFFSET_PRIOR_SD_M ** 2 * offsets @ offsets.T
-         + t ** 2 * obs.kernel_shared[ix] + o ** 2 * obs.kernel_grouped[ix]
-         + v ** 2 * np.diag(obs.floor[take] ** 2 / per_run))
-    if obs.kernel_run is not None and g > 0:
-        a += g ** 2 * obs.kernel_run[ix] / per_run[:, None]
-    return a
+    return CovarianceTerms.of(obs, take, times).at(sizes)
+
+
+@dataclass(frozen=True)
+class CovarianceTerms:
+    """The terms of :func:`covariance_at` over some entries, before their sizes: a bagged
+    copy (:mod:`sim_gap.bagging`) takes them once and combines them at each hypothesis'
+    sizes."""
+
+    noise: np.ndarray
+    offsets: np.ndarray
+    shared: np.ndarray
+    grouped: np.ndarray
+    floor: np.ndarray
+    run: np.ndarray | None
+    per_run: np.ndarray
+
+    @classmethod
+    def of(cls, obs: Observations, take: np.ndarray | None = None,
+           times: np.ndarray | None = None) -> CovarianceTerms:
+        if take is None:
+            take = np.arange(obs.y.size)
+        per_run = np.ones(take.size) if times is None else times
+        ix = np.ix_(take, take)
+        offsets = obs.offsets[take]
+        return cls(np.diag(obs.sigma[take] ** 2 / per_run),
+                   OFFSET_PRIOR_SD_M ** 2 * offsets @ offsets.T,
+                   obs.kernel_shared[ix], obs.kernel_grouped[ix],
+                   np.diag(obs.floor[take] ** 2 / per_run),
+                   None if obs.kernel_run is None else obs.kernel_run[ix], per_run)
+
+    def at(self, sizes: Sequence[float]) -> np.ndarray:
+        """``A`` at ``sizes = (t, o, v, g)``."""
+        t, o, v, g = sizes
+        a = (self.noise + self.offsets + t ** 2 * self.shared + o ** 2 * self.grouped
+             + v ** 2 * self.floor)
+        if self.run is not None and g > 0:
+            a += g ** 2 * self.run / self.per_run[:, None]
+        return a
 
 
 def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covariances:
@@ -197,8 +224,8 @@ def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covaria
     outside = np.zeros(1) if outside is None else np.asarray(outside, float)
     run_grid = RUN_SOIL_GRID if obs.kernel_run is not None else np.zeros(1)
     sizes = np.array(list(itertools.product(TAU_GRID, outside, NUGGET_GRID, run_grid)))
-    lower = np.array([cholesky(covariance_at(obs, s), lower=True, check_finite=False)
-                      for s in sizes])
+    terms = CovarianceTerms.of(obs)
+    lower = np.array([cholesky(terms.at(s), lower=True, check_finite=False) for s in sizes])
     log_det = 2.0 * np.sum(np.log(np.diagonal(lower, axis1=1, axis2=2)), axis=1)
     return Covariances(lower, log_det,
                        (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)), sizes)
