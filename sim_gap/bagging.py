@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_gap.evidence import Covariances, Observations, covariance_at, grid_log_evidence
+from sim_gap.evidence import Covariances, CovarianceTerms, Observations, grid_log_evidence
 from sim_gap.decide import posterior
 
 #: bootstrap copies: the Monte Carlo error of a probability near the 0.9 of a call is then
@@ -82,12 +82,15 @@ def bagged_posterior(models: dict[str, BagModel], prior: dict[str, float], eta: 
         take, times = resample(point, rng.multinomial(n_points,
                                                       np.full(n_points, 1 / n_points)))
         factors: dict[tuple, Covariances] = {}
+        terms: dict[int, CovarianceTerms] = {}
         logs = {}
         for key in keys:
             m = models[key]
             cache = (id(m.obs), m.grid)
             if cache not in factors:
-                factors[cache] = _factor(covariance_at(m.obs, m.grid, take, times))
+                if id(m.obs) not in terms:
+                    terms[id(m.obs)] = CovarianceTerms.of(m.obs, take, times)
+                factors[cache] = _factor(terms[id(m.obs)].at(m.grid))
             logs[key] = m.occam + float(grid_log_evidence(
                 factors[cache], m.obs.y[take], m.predicted[take], m.jac[take], m.offset,
                 m.sd, m.bounds)[0])

@@ -47,7 +47,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from scipy.linalg import cho_solve, cholesky, solve_triangular
+from scipy.linalg import cho_solve, cholesky
+from scipy.linalg.lapack import dpotrf, dpotrs, dtrtrs
 from scipy.special import log_ndtr, logsumexp
 
 from sim_gap.fit import independent_entries, quantities_of
@@ -175,18 +176,45 @@ def covariance_at(obs: Observations, sizes: Sequence[float], take: np.ndarray | 
     (:mod:`sim_gap.bagging`); a run drawn ``m`` times counts as the mean of ``m`` runs at its
     condition, so its noise, nugget and soil (its own, independent from run to run) are
     divided by ``m`` and the discrepancies (of the condition) are not."""
-    t, o, v, g = sizes
-    if take is None:
-        take = np.arange(obs.y.size)
-    per_run = np.ones(take.size) if times is None else times
-    ix = np.ix_(take, take)
-    offsets = obs.offsets[take]
-    a = (np.diag(obs.sigma[take] ** 2 / per_run) + OFFSET_PRIOR_SD_M ** 2 * offsets @ offsets.T
-         + t ** 2 * obs.kernel_shared[ix] + o ** 2 * obs.kernel_grouped[ix]
-         + v ** 2 * np.diag(obs.floor[take] ** 2 / per_run))
-    if obs.kernel_run is not None and g > 0:
-        a += g ** 2 * obs.kernel_run[ix] / per_run[:, None]
-    return a
+    return CovarianceTerms.of(obs, take, times).at(sizes)
+
+
+@dataclass(frozen=True)
+class CovarianceTerms:
+    """The terms of :func:`covariance_at` over some entries, before their sizes: a bagged
+    copy (:mod:`sim_gap.bagging`) takes them once and combines them at each hypothesis'
+    sizes."""
+
+    noise: np.ndarray
+    offsets: np.ndarray
+    shared: np.ndarray
+    grouped: np.ndarray
+    floor: np.ndarray
+    run: np.ndarray | None
+    per_run: np.ndarray
+
+    @classmethod
+    def of(cls, obs: Observations, take: np.ndarray | None = None,
+           times: np.ndarray | None = None) -> CovarianceTerms:
+        if take is None:
+            take = np.arange(obs.y.size)
+        per_run = np.ones(take.size) if times is None else times
+        ix = np.ix_(take, take)
+        offsets = obs.offsets[take]
+        return cls(np.diag(obs.sigma[take] ** 2 / per_run),
+                   OFFSET_PRIOR_SD_M ** 2 * offsets @ offsets.T,
+                   obs.kernel_shared[ix], obs.kernel_grouped[ix],
+                   np.diag(obs.floor[take] ** 2 / per_run),
+                   None if obs.kernel_run is None else obs.kernel_run[ix], per_run)
+
+    def at(self, sizes: Sequence[float]) -> np.ndarray:
+        """``A`` at ``sizes = (t, o, v, g)``."""
+        t, o, v, g = sizes
+        a = (self.noise + self.offsets + t ** 2 * self.shared + o ** 2 * self.grouped
+             + v ** 2 * self.floor)
+        if self.run is not None and g > 0:
+            a += g ** 2 * self.run / self.per_run[:, None]
+        return a
 
 
 def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covariances:
@@ -196,8 +224,8 @@ def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covaria
     outside = np.zeros(1) if outside is None else np.asarray(outside, float)
     run_grid = RUN_SOIL_GRID if obs.kernel_run is not None else np.zeros(1)
     sizes = np.array(list(itertools.product(TAU_GRID, outside, NUGGET_GRID, run_grid)))
-    lower = np.array([cholesky(covariance_at(obs, s), lower=True, check_finite=False)
-                      for s in sizes])
+    terms = CovarianceTerms.of(obs)
+    lower = np.array([cholesky(terms.at(s), lower=True, check_finite=False) for s in sizes])
     log_det = 2.0 * np.sum(np.log(np.diagonal(lower, axis1=1, axis2=2)), axis=1)
     return Covariances(lower, log_det,
                        (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)), sizes)
@@ -291,21 +319,35 @@ def grid_log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, ja
         lo, hi = bounds_from_prior
         prior_in_box = np.sum(_log_interval(lo / prior_sd, hi / prior_sd))
     logs = np.empty(cov.log_det.size)
+    prior_precision = np.diag(1.0 / prior_var)
     for g, (factor, log_det) in enumerate(zip(cov.lower, cov.log_det)):
-        x = solve_triangular(factor, rhs, lower=True, check_finite=False)
+        x = _lapack(dtrtrs, factor, rhs, lower=1)
         xr, xj = x[:, 0], x[:, 1:]
         b = xj.T @ xr
-        m = np.diag(1.0 / prior_var) + xj.T @ xj
-        m_factor = cholesky(m, lower=True, check_finite=False)
-        w = solve_triangular(m_factor, b, lower=True, check_finite=False)
+        m_factor = _lapack(dpotrf, prior_precision + xj.T @ xj, lower=1, clean=1)
+        w = _lapack(dtrtrs, m_factor, b, lower=1)
         logs[g] = (-0.5 * (xr @ xr - w @ w) - 0.5 * log_det
-                   - 0.5 * (np.sum(np.log(prior_var)) + 2.0 * np.sum(np.log(np.diag(
+                   - 0.5 * (np.sum(np.log(prior_var)) + 2.0 * np.sum(np.log(np.diagonal(
                        m_factor)))) - 0.5 * residual.size * np.log(2.0 * np.pi))
         if bounds_from_prior is not None:
-            post_cov = cho_solve((m_factor, True), np.eye(b.size), check_finite=False)
-            mean, sd = post_cov @ b, np.sqrt(np.diag(post_cov))
+            post_cov = _lapack(dpotrs, m_factor, np.eye(b.size), lower=1)
+            mean, sd = post_cov @ b, np.sqrt(np.diagonal(post_cov))
             logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)) - prior_in_box
     return logs
+
+
+def _lapack(routine, *args, **options) -> np.ndarray:
+    """The result of a LAPACK routine of :mod:`scipy.linalg.lapack` (Cholesky factor,
+    triangular solve, solve with a Cholesky factor), raising on failure: the evidence
+    calls these thousands of times per diagnosis on small matrices, where the wrappers of
+    :mod:`scipy.linalg` cost more than the arithmetic. A hypothesis without parameters has
+    empty matrices, which LAPACK refuses: their result is the empty right-hand side."""
+    if args[0].size == 0:
+        return args[-1]
+    out, info = routine(*args, **options)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"{routine.__name__}: LAPACK info {info}")
+    return out
 
 
 def held_out_dispersion(cov: Covariances, grid: int, y: np.ndarray, predicted: np.ndarray,
