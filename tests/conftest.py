@@ -6,11 +6,29 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from swtlab_base.cores import threads_per_worker
+
+
+def pytest_configure(config) -> None:
+    """Each pytest-xdist worker (``make test``: one per core) on its share of the cores,
+    numba, OpenCV and BLAS (scipy's too), as a ``swtlab process --jobs`` worker is: two
+    workers of two threads each on two cores wait for each other's threads (softflow.threads:
+    2 threads took 2.4x the time of one on a busy 2-core machine). The results do not depend
+    on the thread count (tests/test_softflow_threads.py, tests/test_process_parallel.py)."""
+    workers = os.environ.get("PYTEST_XDIST_WORKER_COUNT")
+    if workers and os.environ.get("PYTEST_XDIST_WORKER"):
+        import scipy.linalg  # noqa: F401  (loads scipy's BLAS, so that it is limited too)
+
+        from softflow.threads import limit
+
+        limit(threads_per_worker(int(workers)))
 
 #: true signals of the synthetic spec run (SI units, after calibration and zeroing)
 INGEST_TRUTH = {
