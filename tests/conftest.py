@@ -6,11 +6,36 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from swtlab_base.cores import threads_per_worker
+
+
+def pytest_configure(config) -> None:
+    """Each pytest-xdist worker (``make test``: one per core) runs numba and BLAS (OpenCV's
+    and scipy's too) on its share of the cores, as a ``swtlab process --jobs`` worker does:
+    two workers of two BLAS threads each on two cores wait for each other's threads
+    (softflow.threads; the 62 track photos of tests/test_track_slip*.py on a busy 2-core
+    machine: 81 s, 41 s on one thread). OpenCV's own threads are left as they are:
+    tests/test_process_parallel.py forks workers after this process used OpenCV's thread
+    pool. The results do not depend on the thread count (tests/test_softflow_threads.py sets
+    its own; those 62 results are equal)."""
+    workers = os.environ.get("PYTEST_XDIST_WORKER_COUNT")
+    if workers and os.environ.get("PYTEST_XDIST_WORKER"):
+        import cv2  # noqa: F401  (cv2 and scipy load BLAS libraries of their own:
+        import scipy.linalg  # noqa: F401  loaded now, they are limited too)
+        from threadpoolctl import threadpool_limits
+
+        from softflow.numba_layer import numba
+
+        share = threads_per_worker(int(workers))
+        numba.set_num_threads(min(share, numba.config.NUMBA_NUM_THREADS))
+        threadpool_limits(limits=share)
 
 #: true signals of the synthetic spec run (SI units, after calibration and zeroing)
 INGEST_TRUTH = {

@@ -64,12 +64,14 @@ def test_decay_rates_within_5_percent(smooth_wheels):
 
 
 def test_alpha1_alpha2_from_given_strain(smooth_wheel):
+    """One frame pair: the fit of the given strain is exact algebra on whatever k is measured
+    (the pair gives k in 28 bins, as 3 pairs do)."""
     scene, r = smooth_wheel
-    res = analyse_frames(r.frames[:4], r.t_s[:4], scene.px_per_m)
+    res = analyse_frames(r.frames[:2], r.t_s[:2], scene.px_per_m)
     k = np.array([f.rate_per_m if f else np.nan for f in res.radial])
     alpha1, alpha2 = 2.0, 0.05
     eps = alpha1 / k - alpha2  # the strain for which k = alpha1 / (eps + alpha2) exactly
-    res = analyse_frames(r.frames[:4], r.t_s[:4], scene.px_per_m, eps_vol_by_beta=eps)
+    res = analyse_frames(r.frames[:2], r.t_s[:2], scene.px_per_m, eps_vol_by_beta=eps)
     assert res.alpha12["alpha1_per_m"] == pytest.approx(alpha1, rel=1e-6)
     assert res.alpha12["alpha2"] == pytest.approx(alpha2, rel=1e-6)
     data = res.to_dict()  # a given strain is taken as resolved
@@ -78,12 +80,15 @@ def test_alpha1_alpha2_from_given_strain(smooth_wheel):
                for row in data["per_beta"])
 
 
-@pytest.mark.slow  # optical flow on six supersampled frames per grouser model
+@pytest.mark.slow  # optical flow on four supersampled frames per grouser model
 @pytest.mark.parametrize("model, seed", [("piecewise", 100), ("gear", 103)])
 def test_grouser_model_chosen(model, seed):
+    """Four frames (three pairs): the scores of the four models are those of six frames
+    within 2 % (measured: piecewise 0.00075 against the next 0.00090 m/s, gear 0.00079
+    against 0.00081; six frames 0.00074/0.00089 and 0.00079/0.00081)."""
     scene = FlowScene(grouser_count=12, grouser_height_px=10, grouser_model=model,
                       grouser_gamma=3.0, seed=seed, supersample=3)
-    r = render_flow(scene, 6)
+    r = render_flow(scene, 4)
     res = analyse_frames(r.frames, r.t_s, scene.px_per_m, wheel_radius_px=100,
                          grouser_count=12, grouser_height_px=10)
     assert res.grouser["chosen"] == model, res.grouser
@@ -94,10 +99,10 @@ def test_cli_json(smooth_wheel, tmp_path, capsys):
     scene, r = smooth_wheel
     write_flow_render(r, tmp_path / "run")
     out = tmp_path / "flow.json"
-    assert main(["flow", str(tmp_path / "run"), "--frames", "0:4", "--json", str(out),
+    assert main(["flow", str(tmp_path / "run"), "--frames", "0:3", "--json", str(out),
                  "--plots", str(tmp_path / "plots")]) == 0
     data = json.loads(out.read_text())
-    assert data["frame_range"] == [0, 4] and data["pairs"] == 3
+    assert data["frame_range"] == [0, 3] and data["pairs"] == 2
     row = data["per_beta"][0]
     assert {"beta_deg", "k", "alpha3"} <= set(row)
     assert {"rate_per_m", "ci95_per_m", "r2", "amplitude_mps"} <= set(row["alpha3"])

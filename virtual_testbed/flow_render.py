@@ -330,24 +330,35 @@ def _box_down(img: np.ndarray, s: int) -> np.ndarray:
 
 def _wheel_layer(scene: FlowScene, xs: np.ndarray, ys: np.ndarray, center: tuple[float, float],
                  wheel_angle: float) -> tuple[np.ndarray, np.ndarray]:
-    """Coverage (0..1) and grey level of wheel and grousers at supersampled points."""
-    dx, dy = xs - center[0], ys - center[1]
+    """Coverage (0..1) and grey level of wheel and grousers at supersampled points (the grid
+    ``xs``, ``ys`` of a meshgrid). Computed only in the box holding the grouser tips: outside
+    it the coverage is 0, so the grey level there (70, the wheel's base) is never seen."""
+    reach = scene.wheel_radius_px + max(scene.grouser_height_px, 0.0) + 1.0
+    cols = np.flatnonzero(np.abs(xs[0] - center[0]) <= reach)
+    rows = np.flatnonzero(np.abs(ys[:, 0] - center[1]) <= reach)
+    cover = np.zeros(xs.shape, np.float32)
+    grey = np.full(xs.shape, 70.0, np.float32)
+    if cols.size == 0 or rows.size == 0:
+        return cover, grey
+    box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
+    dx, dy = xs[box] - center[0], ys[box] - center[1]
     r = np.hypot(dx, dy)
     theta = np.arctan2(scene.travel_direction * dx, dy)
     rim = r <= scene.wheel_radius_px
     phi = theta + wheel_angle  # material angle of the wheel (theta + omega t)
-    grey = 70 + 25 * np.cos(6 * phi) * (r < 0.8 * scene.wheel_radius_px) \
+    grey_box = 70 + 25 * np.cos(6 * phi) * (r < 0.8 * scene.wheel_radius_px) \
         + 40 * (np.abs(r - 0.75 * scene.wheel_radius_px) < 3)
-    cover = rim.astype(np.float32)
+    cover_box = rim.astype(np.float32)
     if scene.grouser_count and scene.grouser_height_px > 0:
         pitch = 2 * np.pi / scene.grouser_count
         local = (phi + pitch / 2) % pitch - pitch / 2  # angle to the nearest grouser
         across = r * np.sin(local)
         g = (np.abs(across) <= scene.grouser_thickness_px / 2) & \
             (r <= scene.wheel_radius_px + scene.grouser_height_px) & (np.cos(local) > 0)
-        cover = np.maximum(cover, g.astype(np.float32))
-        grey = np.where(g & ~rim, 170.0, grey)
-    return cover, grey.astype(np.float32)
+        cover_box = np.maximum(cover_box, g.astype(np.float32))
+        grey_box = np.where(g & ~rim, 170.0, grey_box)
+    cover[box], grey[box] = cover_box, grey_box
+    return cover, grey
 
 
 def render_flow(scene: FlowScene, n_frames: int = 4) -> FlowRender:
