@@ -24,15 +24,16 @@ from softflow.numba_layer import numba
 from swtlab_base.cores import available_cores
 
 
-def limit(threads: int) -> None:
+def limit(threads: int, opencv: bool = True) -> None:
     """numba, OpenCV and the BLAS/OpenMP libraries loaded so far (threadpoolctl limits only
     those) on at most ``threads`` threads in this process from now on (numba's count is per
     calling thread: call it from the thread that runs the kernels). softflow's import has
     chosen numba's fork-safe workqueue layer before this starts its threads. OpenCV's count
     is left as it is when it is ``threads`` already (inherited, see
-    :func:`opencv_threads`)."""
+    :func:`opencv_threads`), or when ``opencv`` is false (a process that will fork after
+    using OpenCV's pool must keep the pool it has)."""
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
-    if cv2.getNumThreads() != max(1, threads):
+    if opencv and cv2.getNumThreads() != max(1, threads):
         cv2.setNumThreads(max(1, threads))
     threadpool_limits(limits=threads)
 

@@ -27,15 +27,11 @@ def pytest_configure(config) -> None:
     its own; those 62 results are equal)."""
     workers = os.environ.get("PYTEST_XDIST_WORKER_COUNT")
     if workers and os.environ.get("PYTEST_XDIST_WORKER"):
-        import cv2  # noqa: F401  (cv2 and scipy load BLAS libraries of their own:
-        import scipy.linalg  # noqa: F401  loaded now, they are limited too)
-        from threadpoolctl import threadpool_limits
+        import scipy.linalg  # noqa: F401  (its BLAS, loaded now, is limited too)
 
-        from softflow.numba_layer import numba
+        from softflow.threads import limit
 
-        share = threads_per_worker(int(workers))
-        numba.set_num_threads(min(share, numba.config.NUMBA_NUM_THREADS))
-        threadpool_limits(limits=share)
+        limit(threads_per_worker(int(workers)), opencv=False)
 
 #: true signals of the synthetic spec run (SI units, after calibration and zeroing)
 INGEST_TRUTH = {
