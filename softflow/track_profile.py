@@ -31,9 +31,14 @@ class Strip:
     along_start_px: float  # position of column 0 along the track from the image centre
 
     @cached_property
+    def counts(self) -> np.ndarray:
+        """Valid samples in each row."""
+        return self.valid.sum(axis=1)
+
+    @cached_property
     def centred(self) -> np.ndarray:
         """Samples minus their row mean, zero outside the image."""
-        n = np.maximum(self.valid.sum(axis=1), 1).astype(np.float32)
+        n = np.maximum(self.counts, 1).astype(np.float32)
         x = np.where(self.valid, self.samples, np.float32(0))
         return x - (x.sum(axis=1) / n)[:, None] * self.valid
 
@@ -85,10 +90,13 @@ def resample(gray: np.ndarray, angle_rad: float) -> Strip:
     a = np.arange(-half_len, half_len, STEP_PX, dtype=np.float32)
     c = np.arange(-half_len, half_len + 1, 1.0, dtype=np.float32)
     cos, sin = np.cos(angle_rad), np.sin(angle_rad)
-    map_x = ((w - 1) / 2 + a[None, :] * cos - c[:, None] * sin).astype(np.float32)
-    map_y = ((h - 1) / 2 + a[None, :] * sin + c[:, None] * cos).astype(np.float32)
+    shape = (c.size, a.size)  # maps computed in float64, stored as float32
+    map_x = np.subtract((w - 1) / 2 + a * cos, (c * sin)[:, None],
+                        out=np.empty(shape, np.float32), casting="same_kind")
+    map_y = np.add((h - 1) / 2 + a * sin, (c * cos)[:, None],
+                   out=np.empty(shape, np.float32), casting="same_kind")
     samples = cv2.remap(gray, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
-    valid = (map_x >= 0) & (map_x <= w - 1) & (map_y >= 0) & (map_y <= h - 1)
+    valid = cv2.bitwise_and(cv2.inRange(map_x, 0, w - 1), cv2.inRange(map_y, 0, h - 1)) != 0
     return Strip(angle_rad, samples, valid, float(a[0]))
 
 
@@ -96,7 +104,7 @@ def _row_demodulation(strip: Strip, freq_per_sample: float) -> np.ndarray:
     """Complex amplitude of each row at the frequency (mean over its valid samples)."""
     arg = (2 * np.pi * freq_per_sample * np.arange(strip.samples.shape[1])) % (2 * np.pi)
     both = strip.centred @ np.stack([np.cos(arg), -np.sin(arg)], axis=1).astype(np.float32)
-    return (both[:, 0] + 1j * both[:, 1]) / np.maximum(strip.valid.sum(axis=1), 1)
+    return (both[:, 0] + 1j * both[:, 1]) / np.maximum(strip.counts, 1)
 
 
 def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int, int, float]:
@@ -105,7 +113,7 @@ def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int
     square root of the samples summed (noise adds up incoherently), maximised over every
     contiguous band of at least 3 rows among the rows at least ``min_len`` long; and that
     ratio (in units of the image noise)."""
-    n = strip.valid.sum(axis=1)
+    n = strip.counts
     rows = np.flatnonzero(n >= min_len)
     if rows.size < 3:
         return 0, 0, 0.0

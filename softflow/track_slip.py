@@ -105,9 +105,10 @@ def _measure_direction(gray, angle_rad, freqs_px, min_period_px, max_period_px, 
     strip = track_profile.resample(gray, angle_rad)
     bands = [(*track_profile.find_band(strip, f * step, 4 / (f * step)), f * step)
              for f in freqs_px]
-    *_, freq = max(bands, key=lambda band: band[2])
+    lo, hi, _, freq = max(bands, key=lambda band: band[2])
     for refinement in range(ANGLE_REFINEMENTS + 1):
-        lo, hi, _ = track_profile.find_band(strip, freq, min_len=4 / freq)
+        if refinement:
+            lo, hi, _ = track_profile.find_band(strip, freq, min_len=4 / freq)
         if hi - lo < 3:
             return "no band of marks"
         slope = track_profile.shear_slope(strip, lo, hi, freq)
