@@ -321,12 +321,21 @@ def normalised_median_outliers(flow_px: np.ndarray, valid: np.ndarray, spacing_p
                       if dy or dx])  # (8, H, W, 2)
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN neighbourhoods: flagged below
-        med = np.nanmedian(neigh, axis=0)
-        res = np.nanmedian(np.abs(neigh - med), axis=0)
+        med = _nanmedian0(neigh)
+        res = _nanmedian0(np.abs(neigh - med))
         norm = np.abs(f - med) / (res + eps_px)
     count = np.isfinite(neigh[..., 0]).sum(axis=0)
     bad = (np.nanmax(np.nan_to_num(norm, nan=np.inf), axis=-1) > threshold) | (count < 3)
     return bad & valid
+
+
+def _nanmedian0(x: np.ndarray) -> np.ndarray:
+    """``np.nanmedian(x, axis=0)`` (the same numbers) from one sort: NaN sorts last."""
+    x = np.sort(x, axis=0)
+    n = np.isfinite(x).sum(axis=0)  # a neighbourhood holds no infinity
+    low = np.take_along_axis(x, ((n - 1) // 2)[None], axis=0)[0]
+    high = np.take_along_axis(x, (n // 2)[None], axis=0)[0]
+    return (0.0 + low + high) / 2  # 0.0 +: a zero median is +0.0, as nanmedian gives
 
 
 def _pair_flows(frames: list[np.ndarray], soil_masks: list[np.ndarray], engine: str,
