@@ -332,7 +332,7 @@ def normalised_median_outliers(flow_px: np.ndarray, valid: np.ndarray, spacing_p
 def _nanmedian0(x: np.ndarray) -> np.ndarray:
     """``np.nanmedian(x, axis=0)`` (the same numbers) from one sort: NaN sorts last."""
     x = np.sort(x, axis=0)
-    n = np.isfinite(x).sum(axis=0)  # a neighbourhood holds no infinity
+    n = x.shape[0] - np.isnan(x).sum(axis=0)
     low = np.take_along_axis(x, ((n - 1) // 2)[None], axis=0)[0]
     high = np.take_along_axis(x, (n // 2)[None], axis=0)[0]
     return (0.0 + low + high) / 2  # 0.0 +: a zero median is +0.0, as nanmedian gives
