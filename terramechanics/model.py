@@ -27,6 +27,10 @@ from terramechanics.state import (EARTH_GRAVITY_MPS2, Condition, Contact, Geomet
 from terramechanics.wheel import Wheel
 
 CONVERGED_REL = 1e-3  # |W - Fz| < 0.1 % W
+#: the braked (and towed) branch, s < 0: Wong & Reece 1967 part II (transition angle, flow
+#: zone), or part I's laws at the signed kinematic slip ``i = 1 - v/(r omega) = s/(1 + s)``
+#: (:mod:`terramechanics.stress`)
+BRAKED_LAWS = ("wong_reece1967", "signed_slip")
 
 
 @dataclass(frozen=True)
@@ -37,8 +41,11 @@ class WheelModel:
     soil: SoilParams
     gravity_mps2: float = EARTH_GRAVITY_MPS2
     effects: dict[str, Effect] = field(default_factory=dict)
+    braked_law: str = BRAKED_LAWS[0]
 
     def __post_init__(self) -> None:
+        if self.braked_law not in BRAKED_LAWS:
+            raise ValueError(f"braked_law {self.braked_law!r}: one of {list(BRAKED_LAWS)}")
         unknown = set(self.effects) - set(EFFECTS)
         if unknown:
             raise KeyError(f"unknown effect(s) {sorted(unknown)}; known: {sorted(EFFECTS)}")
@@ -132,7 +139,7 @@ class WheelModel:
                 soil = self.effects[name].soil(soil, cond, self.wheel)
         for effect in self.effects.values():  # geometry sees the soil all effects made
             geo = effect.geometry(geo, soil, cond, self.wheel)
-        contact_forces = _ContactForces(soil, geo, cond)
+        contact_forces = _ContactForces(soil, geo, cond, self.braked_law)
         sinkage, residual = solve_increasing(contact_forces.fz_n,
                                              np.full(cond.slip.shape, self.wheel.radius_m),
                                              cond.load_n, np.maximum(contact_forces.n, 0.0) + 0.5)
@@ -180,12 +187,19 @@ class WheelModel:
 class _ContactForces:
     """Stress integrals at a trial sinkage, for fixed soil state, geometry and condition."""
 
-    def __init__(self, soil: SoilState, geo: Geometry, cond: Condition) -> None:
+    def __init__(self, soil: SoilState, geo: Geometry, cond: Condition,
+                 braked_law: str = BRAKED_LAWS[0]) -> None:
         b = geo.width_m
         self.soil, self.geo, self.cond, self.width = soil, geo, cond, b
+        self.braked_law = braked_law
         self.k_reece = (soil.kc / b + soil.kphi) * b ** soil.n0
         self.slip = cond.slip
-        self.skid = cond.slip < 0
+        if braked_law == "signed_slip":  # part I throughout, at the kinematic slip
+            self.skid = np.zeros(cond.slip.shape, dtype=bool)
+            self.driven_slip = stress.kinematic_slip(cond.slip)
+        else:
+            self.skid = cond.slip < 0
+            self.driven_slip = np.maximum(cond.slip, 0.0)
         # Ding et al. 2011 N = n0 + n1 s driving; n0 + n2 |s| braked (Pavlov & Johnson's
         # CMU model, robomechanics/3d-terramechanics sigma.m)
         slope = np.where(self.skid, soil.n_skid_slope, soil.n_slope)
@@ -202,7 +216,7 @@ class _ContactForces:
         # normal stress peaks at the transition angle, where the shear changes sign
         thetat = np.clip(stress.transition_angle(self.slip, soil.phi_rad), theta2, theta1)
         thetam = np.where(self.skid, thetat, stress.max_stress_angle(
-            theta1, theta2, self.slip, soil.c1, soil.c2))
+            theta1, theta2, self.driven_slip, soil.c1, soil.c2))
         (rear, w_rear), (front, w_front) = (stress.region_grid(theta2, thetam),
                                             stress.region_grid(thetam, theta1))
         theta = np.concatenate([rear, front], axis=-1)
@@ -224,7 +238,8 @@ class _ContactForces:
         """The vertical soil force alone (what the sinkage solve needs), at the conditions
         ``at`` (indices; None: all)."""
         forces = self if at is None else _ContactForces(
-            *(_elements(state, at) for state in (self.soil, self.geo, self.cond)))
+            *(_elements(state, at) for state in (self.soil, self.geo, self.cond)),
+            self.braked_law)
         return forces._fz(forces._stresses(sinkage_m), forces.width)
 
     def __call__(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
@@ -246,16 +261,15 @@ class _ContactForces:
         }
 
     def _shear_displacement(self, theta, sin_theta, theta1, thetat, r_s):
-        """j (m): part I for driven, part II for braked or towed conditions."""
-        slip = self.slip
+        """j (m): part I for driven, part II for braked or towed conditions (part I at the
+        kinematic slip for every condition under the ``signed_slip`` braked law)."""
         if not self.skid.any():  # only the branch the conditions need (most campaigns: one)
-            return stress.shear_displacement(theta, sin_theta, theta1, r_s,
-                                             np.maximum(slip, 0.0))
+            return stress.shear_displacement(theta, sin_theta, theta1, r_s, self.driven_slip)
         braked = stress.skid_shear_displacement(theta, sin_theta, theta1, thetat, r_s,
-                                                np.minimum(slip, 0.0))
+                                                np.minimum(self.slip, 0.0))
         if self.skid.all():
             return braked
-        driven = stress.shear_displacement(theta, sin_theta, theta1, r_s, np.maximum(slip, 0.0))
+        driven = stress.shear_displacement(theta, sin_theta, theta1, r_s, self.driven_slip)
         return np.where(self.skid[..., None], braked, driven)
 
 

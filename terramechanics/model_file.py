@@ -9,7 +9,7 @@ from pathlib import Path
 from swtlab_base.atomic import write_atomically
 from swtlab_base.errors import InputError
 from terramechanics.effects import EFFECTS, make_effect
-from terramechanics.model import WheelModel
+from terramechanics.model import BRAKED_LAWS, WheelModel
 from terramechanics.soil import SOILS, SoilParams
 from terramechanics.state import EARTH_GRAVITY_MPS2
 from terramechanics.wheel import Wheel
@@ -58,8 +58,13 @@ def model_from_dict(data: dict) -> WheelModel:
                 effects[name] = make_effect(name, law, **params)
             except (TypeError, KeyError) as exc:
                 raise ModelFileError(f"[effects.{name}]: {exc}") from None
-    gravity = data.get("model", {}).get("gravity_mps2", EARTH_GRAVITY_MPS2)
-    return WheelModel(wheel=wheel, soil=soil, gravity_mps2=float(gravity), effects=effects)
+    table = data.get("model", {})
+    gravity = table.get("gravity_mps2", EARTH_GRAVITY_MPS2)
+    braked = table.get("braked_law", BRAKED_LAWS[0])
+    if braked not in BRAKED_LAWS:
+        raise ModelFileError(f"[model] braked_law {braked!r}: one of {list(BRAKED_LAWS)}")
+    return WheelModel(wheel=wheel, soil=soil, gravity_mps2=float(gravity), effects=effects,
+                      braked_law=braked)
 
 
 def load_model(path: str | Path) -> WheelModel:
@@ -82,14 +87,16 @@ def shipped_model(name: str) -> WheelModel:
 
 def model_to_dict(model: WheelModel) -> dict:
     """The tables of a model file; effects that are off are written with enabled = false
-    (with their default law); an unset (None) law parameter is left out."""
+    (with their default law); an unset (None) law parameter and the default braked law are
+    left out."""
     effects = {}
     for name, cls in EFFECTS.items():
         effect = model.effects.get(name) or cls()
         effects[name] = {"enabled": name in model.effects, "law": effect.law,
                          **{k: v for k, v in dataclasses.asdict(effect).items()
                             if v is not None}}
-    return {"model": {"gravity_mps2": model.gravity_mps2},
+    braked = {} if model.braked_law == BRAKED_LAWS[0] else {"braked_law": model.braked_law}
+    return {"model": {"gravity_mps2": model.gravity_mps2, **braked},
             "wheel": {k: v for k, v in dataclasses.asdict(model.wheel).items()
                       if v is not None and v != ""},
             "soil": dataclasses.asdict(model.soil),

@@ -44,6 +44,17 @@ NODES = 0.5 * (_NODES + 1.0)  # on [0, 1]
 WEIGHTS = 0.5 * _WEIGHTS
 
 
+def kinematic_slip(slip):
+    """Part I's slip ``i = 1 - v/(r omega)`` of a condition given as driving slip (s >= 0,
+    the same) or skid (s < 0, ``s/(1 + s)``; a locked wheel is taken as i = -1e9). Part I's
+    shear displacement is the rim's slip velocity ``r omega - v cos(theta)`` integrated over
+    the contact (Wong & Reece 1967, part I), so its formula holds for a braked wheel at this
+    signed slip; the rover models of Ishigami et al. 2007 (J. Field Robotics 24(3):233-250)
+    use part I's laws at a signed slip on both branches, which meet at s = 0 without a step."""
+    s = np.asarray(slip, dtype=float)
+    return np.where(s < 0, s / np.maximum(1.0 + s, 1e-9), s)
+
+
 def max_stress_angle(theta1, theta2, slip, c1, c2):
     """theta_m = (c1 + c2 s) theta_1 of a driven wheel (Wong & Reece 1967, part I), kept
     within [theta_2, theta_1]."""

@@ -20,7 +20,9 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from terramechanics import SOILS, WONG_DRY_SAND, SoilParams, Wheel, WheelModel
+from terramechanics import (SOILS, WONG_DRY_SAND, SoilParams, Wheel, WheelModel, load_model,
+                            save_model)
+from terramechanics.model_file import ModelFileError
 
 WHEEL = Wheel(radius_m=0.25, width_m=0.15)
 CMU_RUNS = Path(__file__).resolve().parents[2] / "shared/data/cmu-3d-terramechanics/smooth_runs.csv"
@@ -168,3 +170,64 @@ def test_cmu_skid_runs_with_the_authors_skid_exponent():
     (dp_plain, z_plain), (dp_sloped, z_sloped) = rms(plain), rms(sloped)
     assert dp_sloped < dp_plain < 4.0
     assert z_sloped < z_plain
+
+
+def hand_forces_signed_slip(soil, wheel, sinkage_m, skid):
+    """Fz, DP, T of the ``signed_slip`` braked law at a given sinkage, by quadrature of part
+    I's equations at the kinematic slip i = 1 - v/(r w) = s/(1 + s): peak normal stress at
+    (c1 + c2 i) t1 (kept within the contact), j = r[(t1 - t) - (1 - i)(sin t1 - sin t)]."""
+    r, b, n = wheel.radius_m, wheel.width_m, soil.n
+    phi, c, k_shear = np.radians(soil.friction_angle_deg), soil.cohesion_pa, soil.shear_modulus_m
+    travel = 1.0 / (1.0 + skid)  # v / (r w) = 1 - i
+    t1 = np.arccos(1 - sinkage_m / r)
+    tm = float(np.clip((soil.c1 + soil.c2 * (1.0 - travel)) * t1, 0.0, t1))
+
+    def sigma(t):
+        t_eq = t if t >= tm else t1 - t / tm * (t1 - tm)
+        return (soil.kc / b + soil.kphi) * (r * (np.cos(t_eq) - np.cos(t1))) ** n
+
+    def tau(t):
+        j = r * ((t1 - t) - travel * (np.sin(t1) - np.sin(t)))
+        return np.sign(j) * (c + sigma(t) * np.tan(phi)) * (1 - np.exp(-abs(j) / k_shear))
+
+    def integral(f):
+        return sum(quad(f, lo, hi, epsabs=1e-10, epsrel=1e-10)[0]
+                   for lo, hi in ((0.0, tm), (tm, t1)) if hi > lo)
+
+    fz = b * r * integral(lambda t: sigma(t) * np.cos(t) + tau(t) * np.sin(t))
+    dp = b * r * integral(lambda t: tau(t) * np.cos(t) - sigma(t) * np.sin(t))
+    return fz, dp, b * r * r * integral(tau)
+
+
+@pytest.mark.parametrize("sinkage_m, skid", [(0.03, -0.3), (0.04, -0.05), (0.03, -0.9)])
+def test_signed_slip_law_matches_hand_calculation_of_part_one(sinkage_m, skid):
+    fz, dp, torque = hand_forces_signed_slip(WONG_DRY_SAND, WHEEL, sinkage_m, skid)
+    model = WheelModel(WHEEL, WONG_DRY_SAND, braked_law="signed_slip")
+    out = model.curves(fz, skid)
+    assert out["converged"]
+    assert out["sinkage_m"] == pytest.approx(sinkage_m, rel=1e-4)
+    assert out["dp_n"] == pytest.approx(dp, rel=1e-3, abs=1e-3 * fz)
+    assert out["torque_nm"] == pytest.approx(torque, rel=1e-3, abs=1e-5 * fz)
+
+
+def test_signed_slip_law_has_no_step_at_zero_where_part_two_has_one():
+    """Issue 35 item 8: on every literature soil, DP, torque and sinkage just below s = 0 equal
+    those at s = 0 under ``signed_slip``; part II's peak-stress angle jumps there."""
+    for soil in SOILS.values():
+        signed = WheelModel(WHEEL, soil, braked_law="signed_slip").curves(300.0, [-1e-9, 0.0])
+        for name in ("dp_n", "torque_nm", "sinkage_m"):
+            assert signed[name][0] == pytest.approx(signed[name][1], rel=1e-6, abs=1e-9)
+    part2 = WheelModel(WHEEL, WONG_DRY_SAND).curves(300.0, [-1e-9, 0.0])
+    assert abs(part2["sinkage_m"][0] - part2["sinkage_m"][1]) > 0.05 * part2["sinkage_m"][1]
+
+
+def test_braked_law_is_validated_and_read_from_the_model_file(tmp_path):
+    model = WheelModel(WHEEL, WONG_DRY_SAND, braked_law="signed_slip")
+    save_model(model, tmp_path / "m.toml")
+    assert load_model(tmp_path / "m.toml") == model
+    (tmp_path / "bad.toml").write_text((tmp_path / "m.toml").read_text().replace(
+        '"signed_slip"', '"part3"'))
+    with pytest.raises(ModelFileError, match="braked_law 'part3'"):
+        load_model(tmp_path / "bad.toml")
+    with pytest.raises(ValueError, match="braked_law"):
+        WheelModel(WHEEL, WONG_DRY_SAND, braked_law="part3")
