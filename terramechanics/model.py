@@ -202,7 +202,7 @@ class _ContactForces:
             self.driven_slip = np.maximum(cond.slip, 0.0)
         # Ding et al. 2011 N = n0 + n1 s driving; n0 + n2 |s| braked (Pavlov & Johnson's
         # CMU model, robomechanics/3d-terramechanics sigma.m)
-        slope = np.where(self.skid, soil.n_skid_slope, soil.n_slope)
+        slope = np.where(cond.slip < 0, soil.n_skid_slope, soil.n_slope)
         self.n = soil.n0 + slope * np.abs(cond.slip)
 
     def _stresses(self, sinkage_m: np.ndarray) -> dict[str, np.ndarray]:
