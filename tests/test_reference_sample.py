@@ -22,6 +22,7 @@ def now(processed_sample_db, tmp_path_factory) -> dict[str, str]:
     return outputs(processed_sample_db, tmp_path_factory.mktemp("reference"))
 
 
+@pytest.mark.slow  # the sample campaign (60 runs) processed, exported and diagnosed
 @pytest.mark.parametrize("name", NAMES)
 def test_the_sample_campaign_gives_the_stored_reference(now, name):
     reference = (REFERENCE / name).read_text()

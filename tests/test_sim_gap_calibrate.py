@@ -94,6 +94,7 @@ def test_prediction_bands_match_sampled_posterior():
 
 
 @needs_cmu
+@pytest.mark.slow  # five soil calibrations, each with a slip band held out
 def test_cmu_smooth_wheel_held_out_slip_bands():
     """CMU smooth wheel, 27 straight runs, slip -1 ... 0.9: calibrated on DP and relative
     sinkage with each of five slip bands held out in turn, the held-out DP RMSE is at most

@@ -117,6 +117,7 @@ def _truth_eps(render, beta):
     return np.interp(beta, BETA_GRID, np.nan_to_num(table, nan=-9.0))
 
 
+@pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
 def test_renderer_truth_is_self_consistent_and_independent(runs):
     render, result = runs[0]
     truth = render.truth
@@ -137,6 +138,7 @@ def test_renderer_truth_is_self_consistent_and_independent(runs):
     assert np.all(err <= bound) and np.all(bound > EPS_RESOLUTION)  # measured 0.027-0.038
 
 
+@pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
 def test_eps_from_frames_against_truth(runs):
     for render, result in runs:
         ok = np.isfinite(result.eps_vol_p)
@@ -149,6 +151,7 @@ def test_eps_from_frames_against_truth(runs):
         assert result.eps_source == "estimated" and result.eps_depth_m == pytest.approx(0.02)
 
 
+@pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
 def test_alpha12_across_runs_against_truth(runs):
     """The regression on the estimate taken as it is (gate lifted), then the gate."""
     results = [r for _, r in runs]
@@ -161,6 +164,7 @@ def test_alpha12_across_runs_against_truth(runs):
     assert all(width < np.diff(fit_alpha12_across_runs([r])["alpha2_ci95"])[0] for r in ungated)
 
 
+@pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
 def test_unresolved_strain_gives_no_alpha12(runs):
     results = [r for _, r in runs]
     assert fit_alpha12_across_runs(results) is None

@@ -22,6 +22,7 @@ def test_spacing_is_the_rim_circumference_share():
     assert spacing_m(scene) == pytest.approx(2 * np.pi * 0.125 * 0.75 / 12)  # RUAG: d0 (1 - s)
 
 
+@pytest.mark.slow  # track photos of the second renderer rendered and measured
 def test_slip_within_half_a_point():
     errors = []
     for i, slip in enumerate(np.linspace(0.0, 0.8, 12)):

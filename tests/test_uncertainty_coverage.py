@@ -19,6 +19,8 @@ import pytest
 
 from validation.coverage import coverage, run_coverage
 
+pytestmark = pytest.mark.slow  # three 60-run campaigns generated and processed, one per rig
+
 RUNS = 60
 #: the issue's quantities: DP, torque, wheel load, slip, sinkage, resistance, velocity
 REQUIRED = ("dp_n", "torque_nm", "wheel_load_n", "slip", "sinkage_m", "resistance_n",
