@@ -60,11 +60,11 @@ def model_from_dict(data: dict) -> WheelModel:
                 raise ModelFileError(f"[effects.{name}]: {exc}") from None
     table = data.get("model", {})
     gravity = table.get("gravity_mps2", EARTH_GRAVITY_MPS2)
-    braked = table.get("braked_law", BRAKED_LAWS[0])
-    if braked not in BRAKED_LAWS:
-        raise ModelFileError(f"[model] braked_law {braked!r}: one of {list(BRAKED_LAWS)}")
-    return WheelModel(wheel=wheel, soil=soil, gravity_mps2=float(gravity), effects=effects,
-                      braked_law=braked)
+    try:
+        return WheelModel(wheel=wheel, soil=soil, gravity_mps2=float(gravity), effects=effects,
+                          braked_law=table.get("braked_law", BRAKED_LAWS[0]))
+    except ValueError as exc:
+        raise ModelFileError(f"[model] {exc}") from None
 
 
 def load_model(path: str | Path) -> WheelModel:
