@@ -425,6 +425,20 @@ def _noise_note(report: PosteriorReport) -> list[Note]:
                  warning="measured" not in kinds)] if parts else []
 
 
+def _base_model_note(report: PosteriorReport) -> list[Note]:
+    """Which treatment of the braked runs the base model took, and by how much."""
+    chosen = report.base_model.get("braked_law")
+    if not chosen:
+        return []
+    scores = report.base_model["soil_only_log_evidence"]
+    other = max((law for law in scores if law != chosen), key=scores.__getitem__)
+    words = {"wong_reece1967": "Wong & Reece's part II (a transition angle and a flow zone)",
+             "signed_slip": "part I's laws at the signed slip (no step at zero slip)"}
+    return [Note(f"Braked runs: the base model treats them by {words[chosen]}, whose soil "
+                 f"recalibration is {scores[chosen] - scores[other]:.1f} nats more probable "
+                 f"than with {words[other]} (docs/model-file.md).")]
+
+
 def _laws_text(h: Hypothesis) -> str:
     return ", ".join(f"{EFFECTS.get(e, e)}: {law_text(law)}" for e, law in h.laws.items())
 
@@ -455,7 +469,9 @@ def _probability_blocks(report: PosteriorReport) -> list[Block]:
             Note("Each hypothesis frees the soil and the strengths of its effects (priors: the "
                  "published soils and the ranges the laws cite) and is weighed by its evidence "
                  "(log evidence, natural log) and its prior; the outside hypothesis lets a "
-                 "discrepancy no candidate shapes carry the gap."
+                 "discrepancy no candidate shapes carry the gap (between sources and levels, "
+                 "between travel velocities, or a soil drifting through the campaign), alone "
+                 "or beside one candidate effect."
                  + (f" Probability that each effect is part of the explanation: {effects}."
                     if effects else "")
                  + (f" {more} less probable hypotheses in the JSON report." if more > 0
@@ -592,7 +608,8 @@ def _contrast_blocks(report: PosteriorReport) -> list[Block]:
 
 
 def _schema2_blocks(report: PosteriorReport) -> list[Block]:
-    return (_verdict_blocks(report) + _noise_note(report) + _untestable_note(report)
+    return (_verdict_blocks(report) + _noise_note(report) + _base_model_note(report)
+            + _untestable_note(report)
             + _wheel_and_source_notes(report) + _probability_blocks(report)
             + _curve_blocks(report) + _contrast_blocks(report) + _where_blocks(report)
             + _how_far_blocks(report))

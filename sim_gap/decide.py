@@ -73,11 +73,16 @@ def by_effect_set(hypotheses: list[dict]) -> list[dict]:
     return sorted(sets.values(), key=lambda s: -s["probability"])
 
 
-def by_effect(hypotheses: list[dict], effects: list[str]) -> dict[str, float]:
-    """Probability that each effect is part of the explanation (outside the candidates
-    counts for none of them)."""
+def by_effect(hypotheses: list[dict], effects: list[str],
+              outside_bases: dict[str, float] | None = None) -> dict[str, float]:
+    """Probability that each effect is part of the explanation: the named hypotheses that
+    hold it, and the part of "outside the candidates" whose base holds it
+    (``outside_bases``: effect -> the share of the outside hypothesis' evidence on bases with
+    that effect; an effect outside the vocabulary may act beside one inside it)."""
+    outside = sum(h["probability"] for h in hypotheses if h["key"] == OUTSIDE)
     return {e: float(sum(h["probability"] for h in hypotheses
-                         if h["key"] != OUTSIDE and e in h["effects"])) for e in effects}
+                         if h["key"] != OUTSIDE and e in h["effects"])
+                     + outside * (outside_bases or {}).get(e, 0.0)) for e in effects}
 
 
 def _words(label: str) -> str:

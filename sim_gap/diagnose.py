@@ -14,16 +14,17 @@ import pandas as pd
 from scipy.special import logsumexp
 from threadpoolctl import threadpool_limits
 
-
+from terramechanics.model import BRAKED_LAWS
 from sim_gap import candidates as cands
 from sim_gap.bagging import N_BAGS, BagModel, bagged_posterior
 from sim_gap.crossval import contrasts, cross_validate, folds
 from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate
-from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances, held_out_dispersion,
-                              log_evidence, observations, run_soil)
+from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances,
+                              held_out_dispersion, log_evidence, observations, run_soil,
+                              soil_drift)
 from sim_gap.fit import (MapFit, fit_map, internal_bounds, quantities_of, sigmas, strengths,
                          to_values)
-from sim_gap.hypotheses import (OUTSIDE, admissible, hypothesis_priors, param_prior,
+from sim_gap.hypotheses import (OUTSIDE, admissible, hypothesis_priors, mid_range, param_prior,
                                 set_prior)
 from sim_gap.next_test import TOP_TESTS, next_tests
 from sim_gap.regions import largest_gap, residual_map
@@ -119,6 +120,29 @@ def _evidence(cov, obs, sim: Simulated, f: MapFit) -> Evidence:
                         (lo - centre, hi - centre))
 
 
+def _braked_law(sim: Simulated, points: pd.DataFrame, obs, fit_sig, settings: Settings
+                ) -> tuple[Simulated, dict]:
+    """``sim`` with the base model's braked branch (:data:`terramechanics.model.BRAKED_LAWS`)
+    whose soil-only recalibration has the larger evidence, where the points have braked or
+    towed runs (slip < 0), and the log evidence of each (empty without such runs). The two
+    published treatments of a braked wheel (Wong & Reece 1967 part II; part I at the signed
+    slip, Ishigami et al. 2007) are two forms of the base model with equal prior weight: the
+    choice is made once, by the evidence of soil recalibration alone (type II), before any
+    effect is fitted, so no effect can pick the branch that suits it."""
+    if not (points["slip"].to_numpy(float) < 0).any():
+        return sim, {}
+    trials, scores = {}, {}
+    for law in BRAKED_LAWS:
+        trial = replace(sim, model=replace(sim.model, braked_law=law), _base_cache={})
+        soil = _fit_all(trial, [cands.candidate(trial.model, ())], points, fit_sig,
+                        settings)["soil_only"]
+        obs_law = run_soil(obs, soil.jac, param_prior(soil.fit.candidate, trial.model)[1])
+        trials[law] = trial
+        scores[law] = _evidence(covariances(obs_law), obs_law, trial, soil).log_evidence
+    best = max(scores, key=scores.__getitem__)
+    return trials[best], {"braked_law": best, "soil_only_log_evidence": scores}
+
+
 def _reference_laws(fits: dict[str, MapFit], evidence: dict[str, Evidence]) -> dict[str, str]:
     """Per effect, the law of its single with the largest evidence."""
     best: dict[str, tuple[float, str]] = {}
@@ -135,7 +159,7 @@ def outside_amplitudes(sim: Simulated, points: pd.DataFrame, obs,
     """Amplitudes (floor units) of the discrepancy apart per source and level that stands for
     an effect outside the candidates: a priori as large as the candidate effects are, i.e.
     log-uniform from half the smallest to twice the largest RMS change (in floor units) that
-    one candidate effect makes at its prior centre, over five values."""
+    one candidate effect makes at the middle of its declared ranges, over five values."""
     base = sim.predict(points, {})
     quantities = quantities_of(points)
     base_flat = np.column_stack([base[q] for q in quantities])[obs.where]
@@ -143,8 +167,7 @@ def outside_amplitudes(sim: Simulated, points: pd.DataFrame, obs,
     for c in singles:
         if not c.effects:
             continue
-        centre, _ = param_prior(c, sim.model)
-        pred = sim.predict(points, to_values(c, centre))
+        pred = sim.predict(points, to_values(c, mid_range(c, sim.model)))
         change = np.column_stack([pred[q] for q in quantities])[obs.where] - base_flat
         sizes.append(float(np.sqrt(np.nanmean((change / obs.floor) ** 2))))
     sizes = [s for s in sizes if np.isfinite(s) and s > 0] or [float(TAU_GRID[-1])]
@@ -208,27 +231,74 @@ def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit
     return out
 
 
-def outside(sim: Simulated, obs, amplitudes: np.ndarray, fits: dict[str, MapFit],
+#: what each form of the outside hypothesis stands for (the verdict's reason names the one
+#: that carries most of its evidence)
+OUTSIDE_FORMS = {"levels": "a difference between sources or levels that no candidate makes",
+                 "velocity": "a difference between travel velocities (no candidate depends on "
+                             "the velocity)",
+                 "drift": "a soil that drifts through the campaign (read from the runs' start "
+                          "times)"}
+
+
+def outside_forms(sim: Simulated, points: pd.DataFrame, obs, amplitudes: np.ndarray,
+                  soil: MapFit) -> dict[str, tuple]:
+    """The forms of the hypothesis "an effect outside the candidates", each the observations
+    with its second discrepancy and that discrepancy's sizes: apart per source and level
+    (sized as the candidate effects are, ``amplitudes``, as are the other forms); apart per
+    set travel velocity, where the runs have two or more (no candidate law depends on the
+    velocity, so a rate effect in the soil or the rig is outside them); a soil that drifts
+    through the campaign (:func:`sim_gap.evidence.soil_drift`), where every run's start
+    time is known. One size prior for every form: an effect outside the candidates is a
+    priori as large as the candidate effects are, whatever its form."""
+    forms = {"levels": (obs, amplitudes)}
+    if "velocity_set_mps" in points:
+        velocity = points["velocity_set_mps"].to_numpy(float)
+        if np.isfinite(velocity).all() and np.unique(velocity.round(6)).size >= 2:
+            forms["velocity"] = (apart_by(obs, velocity.round(6)), amplitudes)
+    if "started_unix_h" in points:
+        drift = soil_drift(obs, points["started_unix_h"].to_numpy(float), soil.jac,
+                           param_prior(soil.fit.candidate, sim.model)[1])
+        if drift is not None:
+            forms["drift"] = (drift, amplitudes)
+    return forms
+
+
+def outside(sim: Simulated, obs, forms: dict[str, tuple], fits: dict[str, MapFit],
             reference: dict[str, str], n_admissible: int
-            ) -> tuple[MapFit, Evidence, list[tuple[BagModel, float]]]:
-    """The hypothesis "an effect outside the candidates": a discrepancy apart per source and
-    level (sized as the candidate effects are, ``amplitudes``) on top of soil recalibration
-    alone or of one candidate effect under its reference law. Its prior
+            ) -> tuple[MapFit, Evidence, list[tuple[BagModel, float]], dict[str, float],
+                       dict[str, float]]:
+    """The hypothesis "an effect outside the candidates" on top of soil recalibration alone
+    or of one candidate effect under its reference law, in each of its ``forms``
+    (:func:`outside_forms`) with equal prior weight. Its prior
     (:func:`sim_gap.hypotheses.outside_prior`) is that of an effect outside the vocabulary
-    at work beside any of the candidates, so its evidence is the mixture over those bases
-    weighted by their effect sets' priors (:func:`sim_gap.hypotheses.set_prior`). Returns
-    the most probable base's fit, the mixture's evidence (with that base's discrepancy
-    sizes) and each base's bagging model with its weight."""
-    cov = covariances(obs, amplitudes)
+    at work beside any of the candidates, so its evidence is the mixture over forms and
+    bases weighted by the forms' weights and the bases' effect sets' priors
+    (:func:`sim_gap.hypotheses.set_prior`). Returns the most probable term's fit, the
+    mixture's evidence (with that term's discrepancy sizes), each term's bagging model with
+    its weight, each form's share of the evidence and, per effect, the share of the bases
+    that hold it."""
     bases = _bases(fits, reference)
-    each = [_evidence(cov, obs, sim, f) for f in bases]
     log_weight = np.log([set_prior(f.fit.candidate.effects, n_admissible) for f in bases])
-    log_weight -= logsumexp(log_weight)
-    terms = log_weight + np.array([e.log_evidence for e in each])
+    log_weight -= logsumexp(log_weight) + np.log(len(forms))
+    terms, each, bags, form_of = [], [], [], []
+    for name, (form_obs, sizes) in forms.items():
+        cov = covariances(form_obs, sizes)
+        for f, w in zip(bases, log_weight):
+            e = _evidence(cov, obs, sim, f)
+            terms.append(w + e.log_evidence)
+            each.append((f, e))
+            bags.append((_bag(sim, form_obs, cov, f, e), float(np.exp(w))))
+            form_of.append(name)
+    terms = np.array(terms)
     best = int(np.argmax(terms))
-    bags = [(_bag(sim, obs, cov, f, e), float(np.exp(w)))
-            for f, e, w in zip(bases, each, log_weight)]
-    return bases[best], replace(each[best], log_evidence=float(logsumexp(terms))), bags
+    total = float(logsumexp(terms))
+    shares = {name: float(np.exp(logsumexp(terms[[f == name for f in form_of]]) - total))
+              for name in forms}
+    effects = {e for f in bases for e in f.fit.candidate.effects}
+    with_effect = {e: float(np.exp(logsumexp(terms[[e in f.fit.candidate.effects
+                                                    for f, _ in each]]) - total))
+                   for e in effects}
+    return each[best][0], replace(each[best][1], log_evidence=total), bags, shares, with_effect
 
 
 def _leading_sets(hypotheses: list[dict]) -> list[str]:
@@ -311,6 +381,7 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     sig = sigmas(points, sim.radius_m)
     obs = observations(points, sig, sim.radius_m)
     fit_sig = _fit_noise(points, sig, sim.radius_m)
+    sim, base_model = _braked_law(sim, points, obs, fit_sig, settings)
     single_list = cands.singles(sim.model, allowed)
     fits = _fit_all(sim, single_list, points, fit_sig, settings)
     obs = run_soil(obs, fits["soil_only"].jac,
@@ -329,8 +400,9 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     for key, (c, base, e, bag) in free_forms(sim, points, obs, fits, reference,
                                              amplitudes).items():
         candidate_of[key], fits[key], evidence[key], bags[key] = c, base, e, bag
-    fits[OUTSIDE], evidence[OUTSIDE], outside_bags = outside(sim, obs, amplitudes, fits,
-                                                             reference, len(allowed))
+    forms = outside_forms(sim, points, obs, amplitudes, fits["soil_only"])
+    fits[OUTSIDE], evidence[OUTSIDE], outside_bags, form_shares, outside_effects = outside(
+        sim, obs, forms, fits, reference, len(allowed))
     prior = hypothesis_priors(list(candidate_of.values()), len(allowed))
     eta = learning_rate(_dispersion(sim, obs, cov, fits, evidence, candidate_of))
     probability = _bagged(bags, outside_bags, prior, eta, settings)
@@ -342,6 +414,10 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     separation = (_separation(sim, points, obs, fits, *leaders) if len(leaders) == 2 else None)
     decision = decide(hypotheses, separation, eta)
     decision["reason"] += _discrepancy_text(points, sim, evidence[decision["chosen"]])
+    form, share = max(form_shares.items(), key=lambda kv: kv[1])
+    if hypotheses[0]["key"] == OUTSIDE and len(forms) > 1 and share > 0.5:
+        decision["reason"] += (f"; {share:.0%} of the outside hypothesis' evidence is "
+                               f"{OUTSIDE_FORMS[form]}")
     chosen = fits[decision["chosen"]].fit
     if untestable and decision["verdict"] == []:
         decision["reason"] += ("; not testable with this campaign, so neither found nor ruled "
@@ -366,12 +442,12 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     return {
         "verdict": decision["verdict"], "decision": decision, "hypotheses": hypotheses,
         "effect_sets": by_effect_set(hypotheses),
-        "effect_probabilities": by_effect(hypotheses, list(allowed)),
+        "effect_probabilities": by_effect(hypotheses, list(allowed), outside_effects),
         "untestable_effects": untestable, "contrasts": contrasts(points),
         "sibling_contrasts": sibling_contrasts(points, sig, predictions),
         "folds": [name for name, _ in folds(points)],
         "shrink": shrink(sim, points, before, after, settings.n_boot, settings.seed),
-        "regions": regions, "noise": _noise_source(points),
+        "regions": regions, "noise": _noise_source(points), "base_model": base_model,
         "points": _curves(points, sig, predictions),
         "n_points": len(points), "quantities": quantities_of(points),
         "sinkage_relative": bool(points.attrs.get("sinkage_relative", False)),

@@ -155,6 +155,30 @@ def run_soil(obs: Observations, soil_jac: np.ndarray, soil_spread: np.ndarray
     return replace(obs, kernel_run=np.where(same_point, scaled @ scaled.T, 0.0))
 
 
+def soil_drift(obs: Observations, started_h: np.ndarray, soil_jac: np.ndarray,
+               soil_spread: np.ndarray) -> Observations | None:
+    """``obs`` whose second discrepancy is a soil that drifts through the campaign: the bin
+    loosens or compacts as the runs go on, a slow change whose first-order term is a straight
+    line in time, so the soil under a run started at ``t`` (hours, one per point) differs
+    from the campaign's by ``b u(t)``, ``u = (t - t_mid) / (span / 2)`` (-1 at the first
+    run, +1 at the last) and ``b ~ N(0, diag(s^2))`` (``s``: the soil prior's spread). It
+    moves a run's drawbar pull, torque and sinkage by ``J b u(t)`` (``soil_jac``, as
+    :func:`run_soil`): kernel ``J diag(s^2) J^T u u^T``, of rank at most the number of soil
+    parameters, so it carries a trend in time and nothing that scatters from run to run
+    (that is :func:`run_soil`'s). Scaled to a mean variance of one floor squared, so that its
+    amplitude is in floor units as the other outside forms' are
+    (:func:`sim_gap.diagnose.outside_forms`). None where a run's start time is unknown or all
+    runs started together: then no drift can be told from the soil itself."""
+    times = np.asarray(started_h, float)
+    if not np.isfinite(times).all() or np.ptp(times) <= 0:
+        return None
+    u = (times[obs.point] - 0.5 * (times.min() + times.max())) / (0.5 * np.ptp(times))
+    scaled = soil_jac * soil_spread
+    kernel = (scaled @ scaled.T) * (u[:, None] * u[None, :])
+    size = float(np.mean(np.diagonal(kernel) / obs.floor ** 2))
+    return replace(obs, kernel_grouped=kernel / size) if size > 0 else None
+
+
 @dataclass(frozen=True)
 class Covariances:
     """The noise-plus-discrepancy covariance ``A`` of every grid point (shared amplitude x

@@ -10,7 +10,17 @@ Parameter priors (Gaussian in the fitted coordinates, log for the moduli):
 - an effect's strengths: the range its law declares (``fit`` of each law class, the
   published range its docstring cites) taken as a Gaussian whose +-2 sigma is that range:
   centre the middle, standard deviation a quarter of the range (95 % of the prior inside the
-  published range).
+  published range);
+- except a strength that cannot be negative (declared lower end zero: a bulldozing, slip-
+  sinkage, multipass or hysteresis coefficient, whose zero is that term's absence): a
+  half-normal centred on zero whose 2 sigma is the published upper end (95 % inside the
+  range, as above). Such a strength is known only by how large it can be, so the prior
+  decreases from zero instead of vanishing there: a prior centred mid-range (a "non-local"
+  prior; Johnson & Rossell 2010, "On the use of non-local prior densities in Bayesian
+  hypothesis tests", JRSS B 72:143-170) makes a weak effect count as evidence for its
+  absence and calls it absent with confidence, where a prior centred on the absence (Kass &
+  Raftery 1995, "Bayes factors", JASA 90:773-795, sec. 5) leaves it undecided until the data
+  can tell.
 
 Effect-set priors: each effect that the campaign can carry (:func:`admissible`) is present
 with one unknown probability ``p`` shared by them, uniform on [0, 1]; integrated over ``p``,
@@ -60,11 +70,25 @@ def param_prior(c: Candidate, model: tm.WheelModel) -> tuple[np.ndarray, np.ndar
         if p.name in soil:
             centre.append(to(p.start))
             sd.append(soil[p.name].spread)
+        elif not p.log and p.lower == 0.0:
+            centre.append(0.0)
+            sd.append(0.5 * p.upper)
         else:
             lo, hi = to(p.lower), to(p.upper)
             centre.append(0.5 * (lo + hi))
             sd.append(0.25 * (hi - lo))
     return np.array(centre, float), np.array(sd, float)
+
+
+def mid_range(c: Candidate, model: tm.WheelModel) -> np.ndarray:
+    """``c``'s parameters at the middle of their declared ranges (soil: its prior centre),
+    internal coordinates: how large each effect is a priori, for sizing what an effect
+    outside the candidates may do (:func:`sim_gap.diagnose.outside_amplitudes`)."""
+    centre, _ = param_prior(c, model)
+    soil = {p.name for p in soil_prior(model.wheel.width_m)}
+    return np.array([centre[i] if p.name in soil else
+                     0.5 * sum(map(np.log if p.log else float, (p.lower, p.upper)))
+                     for i, p in enumerate(c.params)], float)
 
 
 def _wheels(points: pd.DataFrame) -> list:

@@ -6,7 +6,10 @@ its source (``wheel_radius_m``, ``wheel_width_m``, ``grouser_count``, ``grouser_
 ``load_set_n`` (set load: grouping), ``wheel_load_n`` (measured wheel load, used in the
 model), ``multipass``, ``gravity_mps2``, ``slip`` and ``<q>``, ``<q>_se`` for the
 quantities of :data:`sim_gap.vocabulary.QUANTITIES` that the source has, and
-``<q>_repeat_sd`` where the source measured its repeatability (:func:`sim_gap.fit.sigmas`).
+``<q>_repeat_sd`` where the source measured its repeatability (:func:`sim_gap.fit.sigmas`);
+``velocity_set_mps`` (set travel velocity) and ``started_unix_h`` where the runs' set
+velocities and start times are known (hours since 1970-01-01 UTC; only
+differences between runs are used, also between sources).
 ``attrs``:
 ``source`` (text), ``wheels`` (source -> its :class:`swtlab_base.domain.Wheel`), ``wheel`` (the
 one measured wheel, None when the sources have several), ``sinkage_relative`` (True when
@@ -40,7 +43,8 @@ def _finish(table: pd.DataFrame, source: str, wheel: Wheel,
     table = table.assign(source=source, **{c: getattr(wheel, c[6:] if c.startswith("wheel_")
                                                       else c) for c in WHEEL_KEY})
     cols = ["run_id", "source", *WHEEL_KEY, "load_set_n", "wheel_load_n", "multipass",
-            "gravity_mps2", "slip"]
+            "gravity_mps2", "slip"] + [c for c in ("velocity_set_mps", "started_unix_h")
+                                       if c in table]
     for q in QUANTITIES:
         if q in table and table[q].notna().any():
             cols += [q, f"{q}_se"] + ([f"{q}_repeat_sd"] if f"{q}_repeat_sd" in table else [])
@@ -107,7 +111,16 @@ def from_results_table(results: pd.DataFrame, source: str = "results") -> pd.Dat
     measured = table["wheel_load_n"] if "wheel_load_n" in table else set_load
     table = table.assign(load_set_n=set_load,
                          wheel_load_n=measured.astype(float).fillna(set_load))
+    if "started_at" in table:
+        table = table.assign(started_unix_h=unix_hours(table["started_at"]))
     return _finish(table, source, _one_wheel(wheels_of(table), source))
+
+
+def unix_hours(started_at: pd.Series) -> np.ndarray:
+    """Hours since 1970-01-01 UTC of ISO 8601 start times (as ``swtlab results`` gives them;
+    a time without a zone is taken as UTC); NaN where a time is missing."""
+    times = pd.to_datetime(started_at, utc=True, errors="coerce", format="ISO8601")
+    return ((times - pd.Timestamp(0, tz="UTC")).dt.total_seconds() / 3600.0).to_numpy(float)
 
 
 def pooled_repeatability(results: pd.DataFrame) -> dict[str, float]:

@@ -234,7 +234,7 @@ class RankedCandidate:
 #: keys a schema-2 report written before they existed lacks, with the value it is read with
 _SCHEMA_2_DEFAULTS: dict[str, Any] = {"learning_rate": None, "next_tests": [],
                                       "admissible_tests": [], "points": [],
-                                      "leaders_separation_sigma": None}
+                                      "leaders_separation_sigma": None, "base_model": {}}
 #: keys :func:`sim_gap.api.gap_report` adds to :func:`sim_gap.report.build_report`'s
 _ADDED = ("wheel", "sources", "effect_sources")
 
@@ -351,7 +351,9 @@ class PosteriorReport(GapReport):
     """A schema-2 report: the posterior probability of each hypothesis
     (:mod:`sim_gap.decide`), the verdict's ``probability`` and the ``call_probability`` it
     needs, the next tests by expected information gain, the sibling contrasts, the noise's
-    source per quantity and each measured point beside the predictions."""
+    source per quantity, the base model's braked branch (``base_model``: the law chosen and
+    the soil-only log evidence of each; empty without braked runs) and each measured point
+    beside the predictions."""
 
     schema: ClassVar[str] = SCHEMA
 
@@ -367,6 +369,7 @@ class PosteriorReport(GapReport):
     hypotheses: tuple[Hypothesis, ...]
     sibling_contrasts: tuple[SiblingContrast, ...]
     noise: Mapping[str, str]
+    base_model: Mapping[str, Any]
     points: tuple[Mapping[str, Any], ...]
 
     def explanation(self, key: str) -> Hypothesis:
@@ -400,7 +403,7 @@ class PosteriorReport(GapReport):
             hypotheses=tuple(Hypothesis.from_json(h) for h in g["hypotheses"]),
             sibling_contrasts=tuple(SiblingContrast.from_json(c)
                                     for c in g["sibling_contrasts"]),
-            noise=g["noise"], points=tuple(g["points"]))
+            noise=g["noise"], base_model=g["base_model"], points=tuple(g["points"]))
 
     def _middle(self) -> Json:
         return {
@@ -415,7 +418,9 @@ class PosteriorReport(GapReport):
             "effect_probabilities": _plain(self.effect_probabilities),
             "hypotheses": [h.to_json() for h in self.hypotheses],
             "sibling_contrasts": [c.to_json() for c in self.sibling_contrasts],
-            "noise": _plain(self.noise), "points": _plain(self.points)}
+            "noise": _plain(self.noise),
+            **({"base_model": _plain(self.base_model)} if self.base_model else {}),
+            "points": _plain(self.points)}
 
 
 @dataclass(frozen=True)

@@ -537,3 +537,16 @@ def test_significant_regions_keeps_the_strongest_twelve():
                for i in range(20) for q, z in (("dp_n", 0.5), ("sinkage_m", -float(i)))]
     keys = significant_regions(regions, "")
     assert [k[1] for k in keys] == [float(i) for i in range(19, 7, -1)]
+
+
+def test_the_braked_branch_the_base_model_took_is_said_in_words(report, tmp_path):
+    with_braked = {**report, "base_model": {
+        "braked_law": "signed_slip",
+        "soil_only_log_evidence": {"wong_reece1967": 80.25, "signed_slip": 92.5}}}
+    page = check_page(write_gap_page(GapReport.from_json(with_braked),
+                                     tmp_path / "gap.html").read_text())
+    note = next(t for t in page.text if t.startswith("Braked runs: "))
+    assert "part I's laws at the signed slip" in note and "12.2 nats more probable" in note
+    assert "Wong & Reece's part II" in note
+    assert not any(t.startswith("Braked runs: ") for t in check_page(
+        Path(write_gap_page(GapReport.from_json(report), tmp_path / "g2.html")).read_text()).text)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 from sqlalchemy import select
 
@@ -26,9 +27,14 @@ REQUIRED = {"verdict", "probability", "hypotheses", "effect_sets", "held_out_rms
 
 def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
     """Multipass missing on the lugged BB2 wheel, in family (the truth is the model's own
-    multipass law)."""
+    multipass law); the runs in a random order, so that a soil drifting through the
+    campaign cannot pass for the second pass. Multipass is found (probability >= 0.9 that it
+    is part of the explanation, and it alone leads); twelve runs cannot rule out weak lugs
+    beside it (docs/gap-report.md), so the verdict is multipass or inconclusive."""
     truth = base_model().with_effects(multipass={"stiffness_gain_per_pass": 0.6})
-    vt.generate_campaign(tmp_path / "out", conditions(FAST_DESIGN)[:12], seed=3,
+    runs = conditions(FAST_DESIGN)[:12]
+    runs = [runs[i] for i in np.random.default_rng(3).permutation(len(runs))]
+    vt.generate_campaign(tmp_path / "out", runs, seed=3,
                          duration_s=FAST_DESIGN.duration_s,
                          testbed=vt.Testbed(law=tm.ModelLaw(truth)))
     db = f"sqlite:///{tmp_path / 'swt.sqlite'}"
@@ -42,25 +48,30 @@ def test_gap_cli_on_a_processed_campaign(tmp_path, capsys):
     report = json.loads((tmp_path / "gap.json").read_text())
     assert REQUIRED <= set(report)
     assert report["n_points"] == 12 and report["contrasts"]["multipass"] == 2
-    assert report["verdict"] == ["multipass"]
-    assert report["probability"] >= report["call_probability"] == 0.9
+    assert report["effect_sets"][0]["label"] == "multipass"
+    assert report["effect_probabilities"]["multipass"] >= report["call_probability"] == 0.9
+    assert report["verdict"] in (["multipass"], "inconclusive")
     best = report["hypotheses"][0]
     assert {"key", "probability", "log_evidence", "parameters"} <= set(best)
     assert best["effects"] == ["multipass"]
+    verdict_line = ("Verdict: the simulation lacks multipass" if report["verdict"] != "inconclusive"
+                    else "Verdict: inconclusive")
     assert report["shrink_pct"]["sinkage_m"] > 50.0
     assert all({"slip_band", "quantity", "z", "significant"} <= set(r) for r in report["regions"])
     html = (tmp_path / "gap.html").read_text()
-    assert "data:image/png;base64," in html and "Verdict: the simulation lacks multipass" in html
-    assert "verdict: multipass" in capsys.readouterr().out
+    assert "data:image/png;base64," in html and verdict_line in html
+    assert "verdict: " + ("multipass" if report["verdict"] != "inconclusive" else
+                          "inconclusive") in capsys.readouterr().out
     # recorded in the measured database, and shown by the campaign report
     with open_database(db)() as session:
         (row,) = session.scalars(select(GapReport)).all()
-        assert row.verdict == ["multipass"] and row.report["shrink_pct"] == report["shrink_pct"]
+        assert row.verdict == report["verdict"]
+        assert row.report["shrink_pct"] == report["shrink_pct"]
         assert row.processing.stage == "gap"
     page = tmp_path / "report.html"
     assert main(["report", "--db", db, "-o", str(page), "--quiet"]) == 0
     section = page.read_text().split('<section id="gap">', 1)[1].split("</section>", 1)[0]
-    assert "Sim-to-real gap" in section and "Verdict: the simulation lacks multipass" in section
+    assert "Sim-to-real gap" in section and verdict_line in section
     assert section.count("data:image/png;base64,") >= 1
 
 

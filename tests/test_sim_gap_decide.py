@@ -4,18 +4,21 @@ truths are this model's own laws), an effect outside the candidates, sibling con
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
 from scipy import integrate, stats
 
 import terramechanics as tm
+from terramechanics.model import BRAKED_LAWS
 from sim_gap import candidates
 from sim_gap.decide import (CALL_PROBABILITY, by_effect_set, decide, learning_rate,
                             posterior)
 from sim_gap.diagnose import Settings, diagnose
 from sim_gap.evidence import (NUGGET_GRID, RUN_SOIL_GRID, TAU_GRID, Observations, covariances,
-                              held_out_dispersion, log_evidence, run_soil)
+                              held_out_dispersion, log_evidence, run_soil, soil_drift)
 from sim_gap.hypotheses import (OUTSIDE, admissible, hypothesis_priors,
                                 outside_prior, set_prior)
 from sim_gap.siblings import contrasts
@@ -121,6 +124,22 @@ def test_priors_sum_to_one_and_split_a_set_over_its_laws():
     assert outside_prior(3) == pytest.approx(0.1 + 0.9 / 4)  # all three: one size of four
 
 
+@pytest.mark.parametrize("law", BRAKED_LAWS)
+def test_the_base_model_takes_the_braked_branch_the_braked_runs_show(law):
+    """In family (the truth is this model under one braked law): with braked runs, the soil
+    recalibrated under the truth's braked law has the larger evidence and every hypothesis
+    is fitted under it; without braked runs nothing is chosen."""
+    truth = replace(BASE.with_soil(**TRUTH_SOIL), braked_law=law)
+    points = synthetic_points(truth, loads=(80.0, 300.0), slips=(-0.4, -0.1, 0.1, 0.4),
+                              multipass=(0,))
+    report = diagnose(points, Simulated(BASE), ["bulldozing"], FAST)
+    assert report["base_model"]["braked_law"] == law
+    evidence = report["base_model"]["soil_only_log_evidence"]
+    assert evidence[law] > max(v for k, v in evidence.items() if k != law) + 5.0
+    driven = points[points["slip"] > 0]
+    assert diagnose(driven, Simulated(BASE), ["bulldozing"], FAST)["base_model"] == {}
+
+
 def test_what_the_lab_declared_limits_the_hypotheses():
     rigid_smooth = Wheel(name="rim", radius_m=0.125, width_m=0.1, grouser_count=0,
                          grouser_height_m=0.0)
@@ -196,6 +215,23 @@ def test_run_soil_moves_one_runs_quantities_together_and_no_other_run():
     assert covariances(obs).shape[-1] == 1
 
 
+def test_soil_drift_is_a_trend_in_the_runs_start_times():
+    """The drift's kernel is the run soil's ``J diag(s^2) J^T`` times ``u u'``, ``u`` the
+    start time from -1 (first run) to +1 (last), scaled to a mean variance of one floor
+    squared: nothing at the campaign's middle, opposite signs at its ends; no drift where a
+    start time is missing or every run started together."""
+    obs, jac = _two_quantity_obs(3, np.random.default_rng(0))
+    spread = np.array([0.4])
+    k = soil_drift(obs, np.array([0.0, 1.0, 2.0]), jac, spread).kernel_grouped
+    soil = run_soil(obs, jac, spread).kernel_run
+    scale = k[0, 1] / soil[0, 1]
+    assert k[0, 4] == pytest.approx(-scale * jac[0, 0] * jac[4, 0] * 0.16)
+    assert k[0, 2] == 0.0 and k[2, 3] == 0.0
+    assert np.mean(np.diagonal(k) / obs.floor ** 2) == pytest.approx(1.0)
+    assert soil_drift(obs, np.array([0.0, np.nan, 2.0]), jac, spread) is None
+    assert soil_drift(obs, np.full(3, 5.0), jac, spread) is None
+
+
 def test_held_out_dispersion_is_the_leave_one_run_out_chi2():
     """The closed form equals each run's entries predicted from all the others by
     conditioning the Gaussian explicitly; data drawn from the model give about 1, data
@@ -259,6 +295,37 @@ def test_a_gap_no_candidate_can_make_is_outside_the_candidates():
     assert report["effect_sets"][0]["label"] == OUTSIDE
     assert report["verdict"] == OUTSIDE
     assert report["decision"]["separating_test"]["test"].startswith("no candidate test")
+
+
+@pytest.mark.slow  # one diagnosis of 24 runs (about 10 s)
+def test_a_soil_that_drifts_through_the_campaign_is_outside_the_candidates():
+    """In family (the base model's own soil laws, the drift a straight line in time): the
+    runs, in a random order 20 min apart, meet a soil whose k_phi falls by a factor 1.6 and
+    friction angle by 3 degrees from the first run to the last. Soil drift is no candidate,
+    so the outside hypothesis leads and the page says it is the drift; without the start
+    times nothing can tell the drift from scatter between runs."""
+    rng = np.random.default_rng(3)
+    points = synthetic_points(BASE.with_soil(**TRUTH_SOIL), multipass=(0,))
+    order = rng.permutation(len(points)) / (len(points) - 1)
+    for i, when in enumerate(order):
+        drifted = BASE.with_soil(kphi=TRUTH_SOIL["kphi"] * np.exp(-0.47 * (when - 0.5)),
+                                 friction_angle_deg=TRUTH_SOIL["friction_angle_deg"]
+                                 - 3.0 * (when - 0.5))
+        row = points.iloc[i]
+        c = drifted.curves(np.array([row["wheel_load_n"]]), np.array([row["slip"]]),
+                           np.array([0]), np.array([row["gravity_mps2"]]))
+        noise = rng.normal(0.0, 1.0, 4) * [0.005 * row["wheel_load_n"],
+                                           0.005 * row["wheel_load_n"] * 0.125, 1e-4,
+                                           0.005 * row["wheel_load_n"]]
+        for q, n in zip(("dp_n", "torque_nm", "sinkage_m", "resistance_n"), noise):
+            points.loc[i, q] = float(c[q][0]) + n
+    points["started_unix_h"] = 490_000.0 + order * (len(points) - 1) / 3.0
+    report = diagnose(points, Simulated(BASE), CANDIDATES, FAST)
+    assert report["effect_sets"][0]["label"] == OUTSIDE
+    assert "soil that drifts through the campaign" in report["decision"]["reason"]
+    blind = diagnose(points.drop(columns="started_unix_h"), Simulated(BASE), CANDIDATES, FAST)
+    outside_p = {r["label"]: r["probability"] for r in blind["effect_sets"]}[OUTSIDE]
+    assert outside_p < report["effect_sets"][0]["probability"]
 
 
 def test_multipass_on_one_level_is_not_a_hypothesis_and_the_page_says_what_it_needs():

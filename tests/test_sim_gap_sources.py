@@ -282,3 +282,26 @@ def test_ding_lug_wheel_against_a_simulation_calibrated_on_the_smooth_wheel(tmp_
     named = [e for e in d["effect_sets"] if e["label"] != "outside_candidates"]
     assert "grousers" in named[0]["effects"]
     assert 0 < dp["predicted"][d["chosen"]] < dp["contrast"]
+
+
+def test_database_points_carry_each_runs_start_time(processed_sample_db):
+    """Each point read from a database keeps its run's start time (``swt.run.started_at`` of
+    the raw file, read here with the mcap library itself) in hours since 1970 UTC, which the
+    soil drift of the outside hypothesis needs (docs/gap-report.md)."""
+    from datetime import datetime
+
+    from mcap.reader import make_reader
+
+    points = load_measured(processed_sample_db)
+    expected = {}
+    for path in (ROOT / "sample_data" / "campaign").glob("*.mcap"):
+        with path.open("rb") as stream:
+            run = next(m.metadata for m in make_reader(stream).iter_metadata()
+                       if m.name == "swt.run")
+        when = datetime.fromisoformat(run["started_at"].replace("Z", "+00:00"))
+        expected[run["run_id"]] = when.timestamp() / 3600.0
+    got = dict(zip(points["run_id"], points["started_unix_h"]))
+    shared = sorted(set(got) & set(expected))
+    assert len(shared) >= 40
+    assert np.allclose([got[r] for r in shared], [expected[r] for r in shared], rtol=0,
+                       atol=1e-6)

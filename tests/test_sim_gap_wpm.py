@@ -61,14 +61,21 @@ def test_wpm_simulation_adds_effects_as_model_corrections(tmp_path):
 
 
 def test_gap_against_a_wpm_simulation_finds_the_injected_effect(tmp_path):
-    """On the smooth BB2 rim (on the lugged one slip-sinkage is aliased with the lugs')."""
+    """On the smooth BB2 rim (on the lugged one slip-sinkage is aliased with the lugs').
+    Slip-sinkage is found (probability >= 0.9 that it is part of the explanation, and it
+    alone leads); 24 points cannot rule out a weak bulldozing beside it, which its prior
+    falling from zero keeps possible (docs/gap-report.md), so the set itself need not reach
+    a call."""
     smooth = BASE.with_wheel(grouser_count=0, grouser_height_m=0.0)
     sim = load_simulated(write_wpm(smooth, tmp_path / "sim.csv"))
     truth = smooth.with_soil(kphi=1.8e7 * 1.3).with_effects(slip_sinkage={"n1": 0.6})
     report = diagnose(synthetic_points(truth, slips=(0.1, 0.3, 0.5, 0.7)), sim,
                       ["slip_sinkage", "bulldozing"],
                       Settings(max_nfev=25, fold_nfev=8, n_boot=20))
-    assert report["verdict"] == ["slip_sinkage"]
+    assert report["effect_sets"][0]["label"] == "slip_sinkage"
+    assert report["effect_probabilities"]["slip_sinkage"] >= 0.9
+    assert report["effect_probabilities"]["bulldozing"] < 0.5
+    assert report["verdict"] in (["slip_sinkage"], "inconclusive")
     assert report["shrink"]["shrink_pct"]["sinkage_m"] > 50.0
 
 

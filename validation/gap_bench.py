@@ -167,7 +167,10 @@ def draw_truth(rng: np.random.Generator, campaign: int = 0) -> tuple[tm.WheelMod
     return model, {"effects": effects, "laws": laws, "parameters": params, "soil": soil_values}
 
 
-def conditions(design: Design):
+def conditions(design: Design, seed: int | None = None):
+    """The design's runs; in a random order drawn from ``seed`` where given (the run order
+    a lab should use, docs/gap-report.md: runs blocked by multipass or gravity level would
+    let a soil that drifts through the campaign pass for the level's effect)."""
     from virtual_testbed import RunCondition
 
     out = []
@@ -177,6 +180,8 @@ def conditions(design: Design):
                 for s in design.slips:
                     out.append(RunCondition.of(f"r{len(out):03d}", "speed_control", load, mp, s,
                                                gravity_mps2=g))
+    if seed is not None:
+        out = [out[i] for i in np.random.default_rng(seed).permutation(len(out))]
     return out
 
 
@@ -197,10 +202,11 @@ def _generate(job) -> None:
         if signal_model == "second":
             from validation.gap_bench_second import write_second_campaign
 
-            write_second_campaign(out, conditions(design), wheel_truth, seed, name,
+            write_second_campaign(out, conditions(design, seed), wheel_truth, seed, name,
                                   design.duration_s, wheel)
         else:
-            generate_campaign(out, conditions(design), seed=seed, duration_s=design.duration_s,
+            generate_campaign(out, conditions(design, seed), seed=seed,
+                              duration_s=design.duration_s,
                               testbed=Testbed(law=tm.ModelLaw(wheel_truth), campaign=name,
                                               wheel=wheel))
         labels = workdir / "labels" / name / part

@@ -28,6 +28,7 @@ import math
 import os
 import shutil
 import tempfile
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +48,9 @@ STEADY_S = 14.5
 #: a lugged wheel runs steady for this many grouser periods at least (at its slowest run):
 #: the chain refuses a window under 2 periods and cuts its start (docs/stable-phase.md)
 STEADY_GROUSER_PERIODS = 4
+#: time between the starts of two consecutive runs beyond the run itself: the bin raked,
+#: levelled and the wheel reset, min
+RESET_MIN = 12.0
 SIX_COUNT_PROBABILITY = (0.25, 0.45, 0.30)
 OUTSIDE_PROBABILITY = 0.25
 MAX_DRAWS = 50
@@ -201,6 +205,17 @@ def rig_inputs(rows: list[dict], campaign: str) -> tuple[list[RunCondition], dic
     return conditions, table
 
 
+def start_times(seed: int, index: int, plan: Plan, run_s: float) -> dict[str, str]:
+    """When each run started (ISO 8601), in the plan's run order: one run after the other,
+    ``run_s`` long and :data:`RESET_MIN` apart, from a morning drawn per campaign; what a
+    lab's log holds and what shows a soil that drifts through the campaign."""
+    day0 = datetime(2026, 3, 2, 8, 0, tzinfo=UTC) + timedelta(days=int(seed) % 200 + index)
+    n = len(plan.runs)
+    return {run.run_id: (day0 + timedelta(seconds=round(run.order * (n - 1))
+                                          * (run_s + 60.0 * RESET_MIN))).isoformat()
+            for _, run in plan.runs}
+
+
 def campaign_names(name: str, plan: Plan) -> dict[str, str]:
     """The campaign name each source's runs carry (the main wheel's, its smooth twin's)."""
     return {"main": name + ("_lugged" if plan.wheel.grouser_count else ""),
@@ -226,13 +241,14 @@ def write_campaign_folder(out: str | Path, seed: int, index: int) -> dict:
         shutil.rmtree(folder)
     rig = lab_rig(seed, index, plan)
     campaign_of = campaign_names(name, plan)
+    started = start_times(seed, index, plan, rig.timeline.duration_s)
     for source, part, rig_truth in (("main", folder, "rig"),
                                     ("smooth", folder / "smooth", "rig-smooth")):
         rows = [r for r in drawn["rows"] if r["source"] == source]
         if not rows:
             continue
         write_campaign(part, *rig_inputs(rows, campaign_of[source]), seed * 1000 + index,
-                       rig=rig)
+                       rig=rig, started_at=started)
         target = out / "truth" / name / rig_truth
         if target.exists():
             shutil.rmtree(target)

@@ -104,11 +104,14 @@ def make_run(condition: RunCondition, truth: Truth, seed: int, started_at: str,
 
 def write_campaign(out_dir: str | Path, conditions: Iterable[RunCondition], truth_fn: Truth,
                    seed: int, *, form: str | Mapping[str, str] = "mcap",
-                   rig: Rig | None = None) -> list[str]:
+                   rig: Rig | None = None, started_at: Mapping[str, str] | None = None
+                   ) -> list[str]:
     """Write every condition's raw run to ``<out_dir>/campaign/`` (``<run_id>.mcap`` or a
     ``<run_id>/`` CSV folder) and its truth to ``<out_dir>/truth/<run_id>.json``; return
     the run ids in order. ``truth_fn``: ``condition -> {TRUTH_KEYS}`` or a table
-    ``{run_id: {...}}``; ``form``: one form for all runs or ``{run_id: form}``."""
+    ``{run_id: {...}}``; ``form``: one form for all runs or ``{run_id: form}``;
+    ``started_at``: ``{run_id: ISO 8601 time}`` where the caller knows when each run started
+    (default: a time drawn from the seed and the run id)."""
     conditions = list(conditions)
     ids = [c.run_id for c in conditions]
     if len(set(ids)) != len(ids):
@@ -125,7 +128,8 @@ def write_campaign(out_dir: str | Path, conditions: Iterable[RunCondition], trut
     try:
         for condition in conditions:
             minutes = int.from_bytes(hashlib.sha256(condition.run_id.encode()).digest()[:4])
-            started = (day0 + timedelta(minutes=minutes % 600)).isoformat()
+            started = (started_at or {}).get(
+                condition.run_id, (day0 + timedelta(minutes=minutes % 600)).isoformat())
             topics, records, document, rng = make_run(condition, truth_fn, seed, started, rig)
             name = condition.run_id + (".mcap" if forms[condition.run_id] == "mcap" else "")
             if forms[condition.run_id] == "mcap":
