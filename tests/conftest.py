@@ -5,6 +5,7 @@ whose true SI values are known."""
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import os
 from dataclasses import dataclass, field
@@ -264,12 +265,36 @@ def db_url(request, tmp_path):
     admin.dispose()
 
 
+def _sqlite_copy(source: Path, target: Path) -> None:
+    """``source`` copied to ``target`` by SQLite's backup (the same database, page for page)."""
+    import sqlite3
+
+    with contextlib.closing(sqlite3.connect(source)) as a, \
+            contextlib.closing(sqlite3.connect(target)) as b:
+        a.backup(b)
+
+
 @pytest.fixture(scope="session")
 def processed_sample_db(tmp_path_factory) -> str:
-    """The committed sample campaign processed once into a SQLite database (URL)."""
+    """The committed sample campaign processed once into a SQLite database (URL); each
+    worker gets its own copy of it. The pytest-xdist workers of one run process it once
+    between them: the first to need it processes, the others wait on a lock, then copy it
+    (the folder above a worker's base temporary folder is that run's own)."""
+    import fcntl
+
     from swtlab_cli.main import main
 
-    url = f"sqlite:///{tmp_path_factory.mktemp('sample_db') / 'swtlab.sqlite'}"
-    campaign = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
-    assert main(["process", str(campaign), "--db", url, "--quiet"]) == 0
-    return url
+    mine = tmp_path_factory.mktemp("sample_db") / "swtlab.sqlite"
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    done = shared / "sample_campaign.sqlite"
+    with open(shared / "sample_campaign.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if done.exists():
+            _sqlite_copy(done, mine)
+        else:
+            campaign = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
+            assert main(["process", str(campaign), "--db", f"sqlite:///{mine}", "--quiet"]) == 0
+            _sqlite_copy(mine, shared / "sample_campaign.partial")
+            (shared / "sample_campaign.partial").rename(done)
+    return f"sqlite:///{mine}"
