@@ -252,9 +252,9 @@ def outside_forms(sim: Simulated, points: pd.DataFrame, obs, amplitudes: np.ndar
     priori as large as the candidate effects are, whatever its form."""
     forms = {"levels": (obs, amplitudes)}
     if "velocity_set_mps" in points:
-        velocity = points["velocity_set_mps"].to_numpy(float)
-        if np.isfinite(velocity).all() and np.unique(velocity.round(6)).size >= 2:
-            forms["velocity"] = (apart_by(obs, velocity.round(6)), amplitudes)
+        velocity = points["velocity_set_mps"].to_numpy(float).round(6)
+        if np.isfinite(velocity).all() and np.unique(velocity).size >= 2:
+            forms["velocity"] = (apart_by(obs, velocity), amplitudes)
     if "started_unix_h" in points:
         drift = soil_drift(obs, points["started_unix_h"].to_numpy(float), soil.jac,
                            param_prior(soil.fit.candidate, sim.model)[1])

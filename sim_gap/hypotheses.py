@@ -74,7 +74,7 @@ def param_prior(c: Candidate, model: tm.WheelModel) -> tuple[np.ndarray, np.ndar
             centre.append(0.0)
             sd.append(0.5 * p.upper)
         else:
-            lo, hi = to(p.lower), to(p.upper)
+            lo, hi = _internal_range(p)
             centre.append(0.5 * (lo + hi))
             sd.append(0.25 * (hi - lo))
     return np.array(centre, float), np.array(sd, float)
@@ -86,9 +86,14 @@ def mid_range(c: Candidate, model: tm.WheelModel) -> np.ndarray:
     outside the candidates may do (:func:`sim_gap.diagnose.outside_amplitudes`)."""
     centre, _ = param_prior(c, model)
     soil = {p.name for p in soil_prior(model.wheel.width_m)}
-    return np.array([centre[i] if p.name in soil else
-                     0.5 * sum(map(np.log if p.log else float, (p.lower, p.upper)))
+    return np.array([centre[i] if p.name in soil else 0.5 * sum(_internal_range(p))
                      for i, p in enumerate(c.params)], float)
+
+
+def _internal_range(p) -> tuple[float, float]:
+    """A parameter's declared range in internal coordinates (log for a log parameter)."""
+    to = np.log if p.log else float
+    return float(to(p.lower)), float(to(p.upper))
 
 
 def _wheels(points: pd.DataFrame) -> list:
