@@ -71,13 +71,14 @@ VARYING_TEXT = {LOAD_VARYING: ", strength varying with load",
 
 def law_text(law: Law) -> str:
     """A law by its authors and year (Wong & Kobayashi 2012); a generalised law says so
-    (Ding 2011, strength varying with load); a law without them by its key."""
-    if law.free_form:
+    (Ding 2011, strength varying with load), and so does one beside a free form; a law
+    without them by its key."""
+    if law.free_form and law.year is None:
         return "a shape none of its laws has: what differs between the levels"
     if law.year is None:
         return law.key
-    return (" & ".join(law.authors) + f" {law.year}"
-            + VARYING_TEXT.get(law.varying or "", ""))
+    return (" & ".join(law.authors) + f" {law.year}" + VARYING_TEXT.get(law.varying or "", "")
+            + (" and what differs between the levels beyond it" if law.free_form else ""))
 
 
 def _effects_text(x: Explained) -> str:

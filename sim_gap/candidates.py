@@ -135,8 +135,16 @@ def candidate(model: tm.WheelModel, effects: tuple[str, ...],
 
 
 #: the law of an effect whose shape none of its laws has: a discrepancy apart per level of
-#: the factor the campaign sets for it (:data:`LEVEL_FACTOR`)
+#: the factor the campaign sets for it (:data:`LEVEL_FACTOR`), alone or beside one of its
+#: laws (``law/free_form``: the law and what differs between the levels beyond it)
 FREE_FORM = "free_form"
+#: the law beside which an effect's free form acts, as in ``krenn_hirzinger2009/free_form``
+BESIDE_LAW = "/"
+
+
+def is_free_form(law: str) -> bool:
+    """Whether ``law`` is :data:`FREE_FORM`, alone or beside a law."""
+    return law == FREE_FORM or law.endswith(BESIDE_LAW + FREE_FORM)
 #: the column of the points that sets each level effect's factor
 LEVEL_FACTOR = {"multipass": "multipass", "reduced_gravity": "gravity_mps2",
                 "grousers": "source"}
@@ -152,7 +160,12 @@ def level_labels(frame: pd.DataFrame, column: str) -> np.ndarray:
 
 
 def with_free_form(c: Candidate, effect: str) -> Candidate:
-    """``c`` with ``effect`` added under :data:`FREE_FORM` (no parameter of its own)."""
+    """``c`` with ``effect`` added under :data:`FREE_FORM` (no parameter of its own), or,
+    where ``c`` has ``effect`` under a law, that law beside the free form."""
+    if effect in c.effects:
+        laws = tuple(f"{law}{BESIDE_LAW}{FREE_FORM}" if e == effect else law
+                     for e, law in zip(c.effects, c.laws))
+        return Candidate(c.effects, c.params, laws)
     order = list(tm.EFFECTS).index
     pairs_ = sorted(zip(c.effects + (effect,), c.laws + (FREE_FORM,)), key=lambda x: order(x[0]))
     return Candidate(tuple(e for e, _ in pairs_), c.params, tuple(law for _, law in pairs_))

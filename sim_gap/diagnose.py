@@ -200,12 +200,10 @@ def _bag(sim: Simulated, obs, cov, f: MapFit, e: Evidence) -> BagModel:
                     e.log_evidence - e.log_at_best)
 
 
-def _bases(fits: dict[str, MapFit], reference: dict[str, str], leaving_out: str | None = None
-           ) -> list[MapFit]:
-    """Soil recalibration alone and each candidate effect under its reference law (but
-    ``leaving_out``): what a free-form effect or an effect outside the candidates acts on."""
-    return [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()
-                                  if e != leaving_out]
+def _bases(fits: dict[str, MapFit], reference: dict[str, str]) -> list[MapFit]:
+    """Soil recalibration alone and each candidate effect under its reference law: what a
+    free-form effect or an effect outside the candidates acts on."""
+    return [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()]
 
 
 def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit],
@@ -213,10 +211,14 @@ def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit
                ) -> dict[str, tuple[cands.Candidate, MapFit, Evidence, BagModel]]:
     """Each level effect (multipass, reduced gravity, grousers with a sibling wheel) with a
     shape none of its laws has: the discrepancy apart per level of its factor, sized as the
-    candidate effects are (``amplitudes``), on top of soil recalibration alone or with each
-    other effect under its reference law. An effect is what differs between the levels of
-    its factor, whatever its shape: "multipass, in a form the laws lack" is a member of the
-    multipass family, not an effect outside the candidates."""
+    candidate effects are (``amplitudes``), on top of soil recalibration alone, of each
+    other effect under its reference law, or of the effect's own reference law (what
+    differs between the levels beyond that law). An effect is what differs between the
+    levels of its factor, whatever its shape: "multipass, in a form the laws lack" is a
+    member of the multipass family, not an effect outside the candidates. Where its factor
+    is the only one that varies, the outside hypothesis' form apart per source and level is
+    the same model on the same bases: the data cannot tell the two apart, and their priors
+    share the probability."""
     out = {}
     for effect in reference:
         levels = _levels(points, effect) if effect in cands.LEVEL_FACTOR else None
@@ -224,7 +226,7 @@ def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit
             continue
         apart = apart_by(obs, levels)
         cov = covariances(apart, amplitudes)
-        for base in _bases(fits, reference, leaving_out=effect):
+        for base in _bases(fits, reference):
             c = cands.with_free_form(base.fit.candidate, effect)
             e = _evidence(cov, obs, sim, base)
             out[c.key] = (c, base, e, _bag(sim, apart, cov, base, e))
@@ -342,7 +344,7 @@ def _dispersion(sim: Simulated, obs, cov, fits: dict[str, MapFit],
     free forms, whose covariance is apart per level), at its most probable discrepancy,
     nugget and run soil."""
     best = max((k for k in evidence if k != OUTSIDE
-                and cands.FREE_FORM not in candidate_of[k].laws),
+                and not any(map(cands.is_free_form, candidate_of[k].laws))),
                key=lambda k: evidence[k].log_evidence)
     f = fits[best]
     centre, sd = param_prior(f.fit.candidate, sim.model)

@@ -68,7 +68,7 @@ import pandas as pd
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.special import logsumexp
 
-from sim_gap.candidates import FREE_FORM, LEVEL_FACTOR, level_labels
+from sim_gap.candidates import LEVEL_FACTOR, is_free_form, level_labels
 from sim_gap.decide import set_label
 from sim_gap.evidence import OFFSET_PRIOR_SD_M, Evidence, Observations, cross_kernel
 from sim_gap.fit import (MapFit, independent_quantities, internal_bounds, quantities_of,
@@ -413,7 +413,7 @@ def _apart(h: dict) -> str | None:
     candidates" goes by (None for the other hypotheses)."""
     if h["key"] == OUTSIDE:
         return OUTSIDE
-    free = [e for e, law in h["laws"].items() if law == FREE_FORM]
+    free = [e for e, law in h["laws"].items() if is_free_form(law)]
     return LEVEL_FACTOR[free[0]] if free else None
 
 

@@ -12,11 +12,11 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar, Protocol, TypeVar
 
 import terramechanics as tm
-from sim_gap.candidates import FREE_FORM
+from sim_gap.candidates import BESIDE_LAW, FREE_FORM, is_free_form
 from sim_gap.hypotheses import OUTSIDE
 from sim_gap.report import READABLE_SCHEMAS, SCHEMA
 from swtlab_base.errors import InputError
@@ -54,7 +54,7 @@ class Law:
 
     @property
     def free_form(self) -> bool:
-        return self.key == FREE_FORM
+        return is_free_form(self.key)
 
     @classmethod
     def of(cls, effect: str, key: str) -> Law:
@@ -62,6 +62,8 @@ class Law:
         the law's class (``relaxes``; :func:`terramechanics.published_law`), whose key is
         its authors' surnames and its year (one module per law, named after its source:
         ``terramechanics/effects``)."""
+        if key.endswith(BESIDE_LAW + FREE_FORM):  # beside the free form: that law's parts
+            return replace(cls.of(effect, key[:-len(BESIDE_LAW + FREE_FORM)]), key=key)
         try:
             published = tm.published_law(effect, key)
         except KeyError:  # free form, or a law of an older swtlab: shown by its key

@@ -493,6 +493,8 @@ def test_plain_words_and_display_units(report_v1):
         "1943, resistance varying with rut depth)")
     assert law_text(Law.of("grousers", "free_form")) == (
         "a shape none of its laws has: what differs between the levels")
+    assert law_text(Law.of("slip_sinkage", "lyasko2010~load/free_form")) == (
+        "Lyasko 2010, strength varying with load and what differs between the levels beyond it")
     for effect, laws in tm.LAWS.items():
         for law in laws:
             assert "_" not in candidate_text(explained({effect: law}))

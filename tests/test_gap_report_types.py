@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 import terramechanics as tm
-from sim_gap.candidates import FREE_FORM
+from sim_gap.candidates import BESIDE_LAW, FREE_FORM
 from sim_gap.report_types import GapReport, HeldOutReport, Law, PosteriorReport, UnknownSchema
 
 DATA = Path(__file__).parent
@@ -73,6 +73,8 @@ def test_a_laws_parts_are_those_of_the_law_it_names():
     assert Law.of("grousers", "bekker1956~slip").varying == "~slip"
     assert Law.of("grousers", FREE_FORM) == Law(FREE_FORM) and Law(FREE_FORM).free_form
     assert Law.of("grousers", "smith1999") == Law("smith1999")  # not a law of this swtlab
+    beside = Law.of("multipass", f"krenn_hirzinger2009{BESIDE_LAW}{FREE_FORM}")
+    assert beside.free_form and (beside.authors, beside.year) == (("Krenn", "Hirzinger"), 2009)
     for effect, laws in tm.LAWS.items():  # every law's key names its authors and year
         for key, cls in laws.items():
             law = Law.of(effect, key)

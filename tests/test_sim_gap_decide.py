@@ -357,3 +357,14 @@ def test_sibling_contrast_of_a_known_shift_at_matched_slips():
     assert c["predicted"]["grousers"] == pytest.approx(1.5)
 
 
+
+
+def test_a_free_form_beside_the_effects_own_law_keeps_the_law_and_its_strengths():
+    single = candidates.candidate(BASE, ("multipass",), {"multipass": "krenn_hirzinger2009"})
+    beside = candidates.with_free_form(single, "multipass")
+    assert beside.effects == ("multipass",) and beside.params == single.params
+    assert beside.key == "multipass(krenn_hirzinger2009/free_form)"
+    assert candidates.is_free_form(beside.laws[0]) and not candidates.is_free_form(single.laws[0])
+    other = candidates.with_free_form(single, "reduced_gravity")
+    assert dict(zip(other.effects, other.laws)) == {"multipass": "krenn_hirzinger2009",
+                                                    "reduced_gravity": candidates.FREE_FORM}
