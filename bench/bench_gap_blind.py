@@ -58,10 +58,6 @@ def main(quick: bool = False) -> dict:
     return out
 
 
-if __name__ == "__main__":
-    main()
-
-
 def markdown(numbers: dict) -> str:
     """docs/validation/gap_blind.md: both truth-law modes by class, beside their goals."""
     lines = ["# The gap verdict on this project's own model (in family)", "",
@@ -85,3 +81,7 @@ def markdown(numbers: dict) -> str:
                      f"(goal <= {100 * MAX_CONFIDENT_WRONG:.0f} %); called outside the "
                      f"candidates {m['outside_called']}")
     return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    main()

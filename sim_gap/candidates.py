@@ -138,16 +138,23 @@ def candidate(model: tm.WheelModel, effects: tuple[str, ...],
 #: the factor the campaign sets for it (:data:`LEVEL_FACTOR`), alone or beside one of its
 #: laws (``law/free_form``: the law and what differs between the levels beyond it)
 FREE_FORM = "free_form"
-#: the law beside which an effect's free form acts, as in ``krenn_hirzinger2009/free_form``
+#: what joins a law and the free form beside it, as in ``krenn_hirzinger2009/free_form``
 BESIDE_LAW = "/"
+#: the column of the points that sets each level effect's factor
+LEVEL_FACTOR = {"multipass": "multipass", "reduced_gravity": "gravity_mps2",
+                "grousers": "source"}
+
+
+def law_beside(law: str) -> str | None:
+    """The law beside which ``law`` puts the free form (``krenn_hirzinger2009`` of
+    ``krenn_hirzinger2009/free_form``), None for any other law."""
+    suffix = BESIDE_LAW + FREE_FORM
+    return law[:-len(suffix)] if law.endswith(suffix) else None
 
 
 def is_free_form(law: str) -> bool:
     """Whether ``law`` is :data:`FREE_FORM`, alone or beside a law."""
-    return law == FREE_FORM or law.endswith(BESIDE_LAW + FREE_FORM)
-#: the column of the points that sets each level effect's factor
-LEVEL_FACTOR = {"multipass": "multipass", "reduced_gravity": "gravity_mps2",
-                "grousers": "source"}
+    return law == FREE_FORM or law_beside(law) is not None
 
 
 def level_labels(frame: pd.DataFrame, column: str) -> np.ndarray:

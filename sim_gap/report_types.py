@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 from typing import Any, ClassVar, Protocol, TypeVar
 
 import terramechanics as tm
-from sim_gap.candidates import BESIDE_LAW, FREE_FORM, is_free_form
+from sim_gap.candidates import is_free_form, law_beside
 from sim_gap.hypotheses import OUTSIDE
 from sim_gap.report import READABLE_SCHEMAS, SCHEMA
 from swtlab_base.errors import InputError
@@ -62,8 +62,9 @@ class Law:
         the law's class (``relaxes``; :func:`terramechanics.published_law`), whose key is
         its authors' surnames and its year (one module per law, named after its source:
         ``terramechanics/effects``)."""
-        if key.endswith(BESIDE_LAW + FREE_FORM):  # beside the free form: that law's parts
-            return replace(cls.of(effect, key[:-len(BESIDE_LAW + FREE_FORM)]), key=key)
+        beside = law_beside(key)
+        if beside is not None:  # a law beside the free form: that law's parts
+            return replace(cls.of(effect, beside), key=key)
         try:
             published = tm.published_law(effect, key)
         except KeyError:  # free form, or a law of an older swtlab: shown by its key

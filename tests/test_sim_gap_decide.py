@@ -357,8 +357,6 @@ def test_sibling_contrast_of_a_known_shift_at_matched_slips():
     assert c["predicted"]["grousers"] == pytest.approx(1.5)
 
 
-
-
 def test_a_free_form_beside_the_effects_own_law_keeps_the_law_and_its_strengths():
     single = candidates.candidate(BASE, ("multipass",), {"multipass": "krenn_hirzinger2009"})
     beside = candidates.with_free_form(single, "multipass")

@@ -27,9 +27,9 @@ def latest_results(session: Session) -> pd.DataFrame:
     newest_result = (select(RunResult.raw_file_id, func.max(RunResult.id).label("result_id"))
                      .group_by(RunResult.raw_file_id).subquery())
     rows = session.execute(
-        select(Campaign.name, Run.run_id, Run.started_at, RawFile.version, RawFile.path,
-               RawFile.sha256, RawFile.missing_since, Wheel, Soil.name, TestCondition,
-               RunResult, StableWindow)
+        select(Campaign.name.label("campaign"), Run.run_id, Run.started_at, RawFile.version,
+               RawFile.path, RawFile.sha256, RawFile.missing_since, Wheel,
+               Soil.name.label("soil"), TestCondition, RunResult, StableWindow)
         .join(Run.campaign).join(Run.condition).join(TestCondition.wheel)
         .join(TestCondition.soil)
         .join(RawFile, (RawFile.run_pk == Run.id) & (RawFile.version == Run.current_version))
@@ -55,12 +55,12 @@ def latest_results(session: Session) -> pd.DataFrame:
     for row in rows:
         cond, result, window = row.TestCondition.to_domain(), row.RunResult, row.StableWindow
         records.append({
-            "campaign": row[0], "run_id": row.run_id,
+            "campaign": row.campaign, "run_id": row.run_id,
             "started_at": None if row.started_at is None else row.started_at.isoformat(),
             "raw_file_version": row.version,
             "raw_file_path": row.path, "raw_file_sha256": row.sha256,
             "raw_file_missing": row.missing_since is not None,
-            **wheel_columns(row.Wheel), "soil": row[8], "mode": cond.mode,
+            **wheel_columns(row.Wheel), "soil": row.soil, "mode": cond.mode,
             "multipass": cond.multipass,
             "load_set_n": cond.load_set_n, "slip_setpoint": cond.slip_setpoint,
             "velocity_set_mps": cond.velocity_set_mps, "gravity_mps2": cond.gravity_mps2,
