@@ -34,6 +34,15 @@ def smooth_wheel():
     return _render(5)
 
 
+@pytest.fixture(scope="module")
+def smooth_wheel_folder(smooth_wheel, tmp_path_factory):
+    """That render written once as a run folder (frames, run.json, truth apart), read by the
+    CLI and the frame loader; neither writes into it."""
+    folder = tmp_path_factory.mktemp("smooth_wheel") / "run"
+    write_flow_render(smooth_wheel[1], folder)
+    return folder
+
+
 def _contact(result):
     beta = result.beta_rad
     return (beta < -np.deg2rad(20)) & (beta > -np.deg2rad(160))
@@ -95,11 +104,9 @@ def test_grouser_model_chosen(model, seed):
     assert set(res.grouser["scores_mps"]) == {"piecewise", "cosine", "cosine_series", "gear"}
 
 
-def test_cli_json(smooth_wheel, tmp_path, capsys):
-    scene, r = smooth_wheel
-    write_flow_render(r, tmp_path / "run")
+def test_cli_json(smooth_wheel_folder, tmp_path, capsys):
     out = tmp_path / "flow.json"
-    assert main(["flow", str(tmp_path / "run"), "--frames", "0:3", "--json", str(out),
+    assert main(["flow", str(smooth_wheel_folder), "--frames", "0:3", "--json", str(out),
                  "--plots", str(tmp_path / "plots")]) == 0
     data = json.loads(out.read_text())
     assert data["frame_range"] == [0, 3] and data["pairs"] == 2
@@ -115,10 +122,9 @@ def test_cli_bad_input(tmp_path, capsys):
     assert "no such file" in capsys.readouterr().err
 
 
-def test_frames_from_folder_range(smooth_wheel, tmp_path):
+def test_frames_from_folder_range(smooth_wheel, smooth_wheel_folder):
     scene, r = smooth_wheel
-    write_flow_render(r, tmp_path / "run")
-    fs = load_frames(tmp_path / "run", (2, 5))
+    fs = load_frames(smooth_wheel_folder, (2, 5))
     assert fs.frame_range == (2, 5) and len(fs.frames) == 3
     assert fs.t_s == pytest.approx(r.t_s[2:5])
     assert fs.px_per_m == scene.px_per_m and fs.wheel_radius_px == pytest.approx(100)
