@@ -374,6 +374,8 @@ def test_reliability_bins_count_each_campaign_once():
 
 
 @pytest.mark.slow  # one campaign (22 runs) through swtlab process and swtlab gap: about 20 s
+@pytest.mark.slow_campaign
+@pytest.mark.slow_diagnosis
 def test_calibration_bench_runs_the_full_chain_on_a_subset(tmp_path):
     """Plumbing of ``python -m bench gap_calibration`` on one campaign of a seed kept for
     this test (9001): the campaign written, processed, diagnosed and scored (one is enough

@@ -40,6 +40,7 @@ def _limits(_) -> dict:
 
 
 @pytest.mark.parametrize("limit", [limit_threads, softflow_limit], ids=["runs", "frame_pairs"])
+@pytest.mark.slow_workers  # restarts the cluster's two worker processes
 def test_each_task_runs_on_its_share_of_its_hosts_cores(client, limit):
     """2 one-thread workers on this host: each task gets cores // 2 threads (1 on 2 cores),
     not the thread per core each library starts with; with the runs' limit (``swtlab
@@ -76,6 +77,8 @@ def render():
     return scene, render_flow(scene, 3)
 
 
+@pytest.mark.slow_render  # three frames rendered (module fixture), four flows measured
+@pytest.mark.slow_workers
 def test_frame_pairs_on_the_cluster_give_the_local_flow(client, render, tmp_path):
     scene, r = render
     here = analyse_frames(r.frames, r.t_s, scene.px_per_m)

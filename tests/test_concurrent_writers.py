@@ -56,6 +56,7 @@ def _stored(db_url: str) -> dict[str, object]:
 
 
 @pytest.mark.slow  # four swtlab processes at once, each starting the whole stack
+@pytest.mark.slow_workers
 @pytest.mark.parametrize("layout", ["same folder", "disjoint folders"])
 def test_four_writers_at_once_store_every_run_once(tmp_path, db_url, ingest_tools, layout):
     run_ids = [f"r{i:03d}" for i in range(WRITERS)]

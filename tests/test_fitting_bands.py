@@ -108,6 +108,7 @@ def virtual_campaigns(tmp_path_factory):
 
 
 @pytest.mark.slow  # two 60 s virtual campaigns generated and processed
+@pytest.mark.slow_campaign
 def test_virtual_testbed_bands_cover_the_law_and_held_out_runs(virtual_campaigns):
     """Measured (seeds 21, 22, budget uncertainties of processed raw runs): confidence at the
     tested loads DP 0.90, torque 0.87, sinkage 0.89, resistance 0.97; at 120 N 0.94 / 0.84 /

@@ -16,6 +16,7 @@ INPUTS = 500
 
 
 @pytest.mark.slow  # 500 mutated runs, each read and processed
+@pytest.mark.slow_campaign
 def test_five_hundred_mutated_runs_fail_cleanly_or_give_sound_results():
     counts, faults = fuzz(INPUTS, SEED)
     total = sum(counts.values(), Counter())

@@ -21,7 +21,8 @@ from validation.gap_bench import (MARS_GRAVITY_MPS2, Design, base_model, diagnos
                                   draw_truth, laws_option, run_bench, score, truth_law)
 from virtual_testbed.rig import BB2_WHEEL
 
-pytestmark = pytest.mark.slow  # three whole campaigns generated, processed, diagnosed
+pytestmark = [pytest.mark.slow,  # three whole campaigns generated, processed, diagnosed
+              pytest.mark.slow_campaign, pytest.mark.slow_diagnosis]
 
 #: 8 runs: every contrast the bench needs (load, slip, multipass, gravity) once
 TINY = Design(loads_n=(80.0, 250.0), slips=(0.2, 0.6), multipass=(0, 1),
@@ -132,6 +133,7 @@ def _files(folder) -> dict:
             if p.is_file() and p.suffix != ".sqlite" and not p.name.startswith("score-")}
 
 
+@pytest.mark.slow_workers  # a two-worker LocalCluster started
 def test_a_gap_bench_campaign_on_the_cluster_is_the_local_one(bench, tmp_path):
     """The bench's first campaign (8 runs; held-out laws: one law per family, the fastest
     diagnosis) made, processed and diagnosed again in a task on the cluster: every file (raw

@@ -19,6 +19,8 @@ SEED = 5
 
 
 @pytest.mark.slow  # 16 runs processed and diagnosed as two sources
+@pytest.mark.slow_campaign
+@pytest.mark.slow_diagnosis
 def test_smooth_wheel_runs_on_the_same_hidden_soil_and_is_diagnosed_with_the_lugged(tmp_path):
     run_bench(1, SEED, tmp_path, TINY, jobs=1, boot=5, truth_laws="held-out")
     label = json.loads((tmp_path / "labels" / "labels.json").read_text())["c000"]

@@ -93,6 +93,7 @@ def _threads_after_a_run(path: Path) -> dict:
             "blas": {i["filepath"]: i["num_threads"] for i in threadpool_info()}}
 
 
+@pytest.mark.slow_workers  # a pool of two worker processes started
 def test_each_of_two_workers_runs_on_its_share_of_the_cores():
     """On 2 cores each of 2 workers runs 1 numba, OpenCV and BLAS thread (not 2), also
     after a run with soil flow (numba kernels, OpenCV, libraries loaded by the run); and
@@ -121,6 +122,7 @@ def test_the_cores_are_split_evenly_and_never_below_one_thread():
         threads_per_worker(0)
 
 
+@pytest.mark.slow_workers  # a two-worker LocalCluster started
 def test_a_dask_cluster_of_two_workers_gives_the_serial_results(campaign, serial, tmp_path,
                                                                 capsys):
     distributed = pytest.importorskip("distributed")

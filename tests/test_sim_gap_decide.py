@@ -263,6 +263,7 @@ def test_held_out_dispersion_is_the_leave_one_run_out_chi2():
     assert np.mean(draws[40:]) == pytest.approx(4.0, abs=0.6)
 
 
+@pytest.mark.slow_diagnosis  # one diagnosis of 48 points per case
 @pytest.mark.parametrize("effects, expected", [
     ({}, []),
     ({"bulldozing": {"coefficient": 1.5}}, ["bulldozing"]),
@@ -298,6 +299,7 @@ def test_a_gap_no_candidate_can_make_is_outside_the_candidates():
 
 
 @pytest.mark.slow  # one diagnosis of 24 runs (about 10 s)
+@pytest.mark.slow_diagnosis
 def test_a_soil_that_drifts_through_the_campaign_is_outside_the_candidates():
     """In family (the base model's own soil laws, the drift a straight line in time): the
     runs, in a random order 20 min apart, meet a soil whose k_phi falls by a factor 1.6 and

@@ -49,6 +49,7 @@ def _contact(result):
 
 
 @pytest.mark.slow  # optical flow on ten rendered frames, two renders
+@pytest.mark.slow_render
 def test_decay_rates_within_5_percent(smooth_wheels):
     scene, r = smooth_wheels
     res = analyse_frames(r.frames, r.t_s, scene.px_per_m)
@@ -90,6 +91,7 @@ def test_alpha1_alpha2_from_given_strain(smooth_wheel):
 
 
 @pytest.mark.slow  # optical flow on four supersampled frames per grouser model
+@pytest.mark.slow_render
 @pytest.mark.parametrize("model, seed", [("piecewise", 100), ("gear", 103)])
 def test_grouser_model_chosen(model, seed):
     """Four frames (three pairs): the scores of the four models are those of six frames

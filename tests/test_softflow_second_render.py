@@ -45,6 +45,8 @@ def sky_run():
     return scene, render_second(scene, 4)
 
 
+@pytest.mark.slow  # the sky run's four frames rendered (module fixture) and their flow measured
+@pytest.mark.slow_render
 def test_sled_velocity_within_1_percent_and_reasons_per_angle(sky_run):
     scene, (frames, t_s, truth) = sky_run
     res = analyse_frames(frames, t_s, scene.px_per_m)
@@ -58,6 +60,7 @@ def test_sled_velocity_within_1_percent_and_reasons_per_angle(sky_run):
     assert all("not defined" in row["k_reason"] for row in under)  # v_r = 0 under the axle
 
 
+@pytest.mark.slow_render  # three frames rendered again, written and measured by swtlab flow
 def test_cli_fails_on_an_implausible_sled_velocity(sky_run, tmp_path, capsys):
     """The frames say the soil moves towards the image right while the metadata say the wheel
     travels to the left: the far soil would move with the sled. Exit 3, no JSON."""

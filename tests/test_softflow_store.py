@@ -28,7 +28,8 @@ from virtual_testbed.campaign import generate_campaign
 from virtual_testbed.conditions import RunCondition
 from virtual_testbed.sensors import Rates
 
-pytestmark = pytest.mark.slow  # a filmed campaign generated, processed: flow on every pair
+pytestmark = [pytest.mark.slow,  # a filmed campaign generated, processed: flow on every pair
+              pytest.mark.slow_campaign, pytest.mark.slow_render]
 
 RATES = Rates(40.0, 40.0, 20.0, 20.0, 10.0, 10.0)
 FILMED = {"FLOW_MCAP": "mcap", "FLOW_CSV": "csv"}

@@ -118,6 +118,7 @@ def _truth_eps(render, beta):
 
 
 @pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
+@pytest.mark.slow_render
 def test_renderer_truth_is_self_consistent_and_independent(runs):
     render, result = runs[0]
     truth = render.truth
@@ -139,6 +140,7 @@ def test_renderer_truth_is_self_consistent_and_independent(runs):
 
 
 @pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
+@pytest.mark.slow_render
 def test_eps_from_frames_against_truth(runs):
     for render, result in runs:
         ok = np.isfinite(result.eps_vol_p)
@@ -152,6 +154,7 @@ def test_eps_from_frames_against_truth(runs):
 
 
 @pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
+@pytest.mark.slow_render
 def test_alpha12_across_runs_against_truth(runs):
     """The regression on the estimate taken as it is (gate lifted), then the gate."""
     results = [r for _, r in runs]
@@ -165,6 +168,7 @@ def test_alpha12_across_runs_against_truth(runs):
 
 
 @pytest.mark.slow  # the strain runs' frames rendered and their flow measured (module fixture)
+@pytest.mark.slow_render
 def test_unresolved_strain_gives_no_alpha12(runs):
     results = [r for _, r in runs]
     assert fit_alpha12_across_runs(results) is None

@@ -34,6 +34,7 @@ def _random_render(i: int):
 
 
 @pytest.mark.slow  # 50 track photos rendered and measured
+@pytest.mark.slow_render
 def test_accuracy_over_50_random_renders():
     errors_pp, refused = [], 0
     for i in range(RENDERS):

@@ -23,6 +23,7 @@ def test_spacing_is_the_rim_circumference_share():
 
 
 @pytest.mark.slow  # track photos of the second renderer rendered and measured
+@pytest.mark.slow_render
 def test_slip_within_half_a_point():
     errors = []
     for i, slip in enumerate(np.linspace(0.0, 0.8, 12)):

@@ -19,7 +19,8 @@ import pytest
 
 from validation.coverage import coverage, run_coverage
 
-pytestmark = pytest.mark.slow  # three 60-run campaigns generated and processed, one per rig
+pytestmark = [pytest.mark.slow,  # three 60-run campaigns generated and processed, one per rig
+              pytest.mark.slow_campaign]
 
 RUNS = 60
 #: the issue's quantities: DP, torque, wheel load, slip, sinkage, resistance, velocity
