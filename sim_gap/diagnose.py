@@ -20,8 +20,8 @@ from sim_gap.bagging import N_BAGS, BagModel, bagged_posterior
 from sim_gap.crossval import contrasts, cross_validate, folds
 from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate
 from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances,
-                              held_out_dispersion, log_evidence, observations, run_soil,
-                              soil_drift)
+                              held_out_dispersion, level_groups, log_evidence,
+                              observations, run_soil, same_partition, soil_drift)
 from sim_gap.fit import (MapFit, fit_map, internal_bounds, quantities_of, sigmas, strengths,
                          to_values)
 from sim_gap.hypotheses import (OUTSIDE, admissible, hypothesis_priors, mid_range, param_prior,
@@ -206,24 +206,21 @@ def _bases(fits: dict[str, MapFit], reference: dict[str, str]) -> list[MapFit]:
     return [fits["soil_only"]] + [fits[f"{e}({law})"] for e, law in reference.items()]
 
 
-def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit],
-               reference: dict[str, str], amplitudes: np.ndarray
+def free_forms(sim: Simulated, obs, fits: dict[str, MapFit], reference: dict[str, str],
+               free_levels: dict[str, np.ndarray], amplitudes: np.ndarray
                ) -> dict[str, tuple[cands.Candidate, MapFit, Evidence, BagModel]]:
     """Each level effect (multipass, reduced gravity, grousers with a sibling wheel) with a
     shape none of its laws has: the discrepancy apart per level of its factor, sized as the
     candidate effects are (``amplitudes``), on top of soil recalibration alone, of each
     other effect under its reference law, or of the effect's own reference law (what
-    differs between the levels beyond that law). An effect is what differs between the
+    differs between the levels beyond that law); ``free_levels``: effect -> its factor's
+    level per point (:func:`_levels`). An effect is what differs between the
     levels of its factor, whatever its shape: "multipass, in a form the laws lack" is a
-    member of the multipass family, not an effect outside the candidates. Where its factor
-    is the only one that varies, the outside hypothesis' form apart per source and level is
-    the same model on the same bases: the data cannot tell the two apart, and their priors
-    share the probability."""
+    member of the multipass family, not an effect outside the candidates (which therefore
+    does not take this form where the effect's factor is the only one that varies:
+    :func:`outside_forms`)."""
     out = {}
-    for effect in reference:
-        levels = _levels(points, effect) if effect in cands.LEVEL_FACTOR else None
-        if levels is None:
-            continue
+    for effect, levels in free_levels.items():
         apart = apart_by(obs, levels)
         cov = covariances(apart, amplitudes)
         for base in _bases(fits, reference):
@@ -235,7 +232,8 @@ def free_forms(sim: Simulated, points: pd.DataFrame, obs, fits: dict[str, MapFit
 
 #: what each form of the outside hypothesis stands for (the verdict's reason names the one
 #: that carries most of its evidence)
-OUTSIDE_FORMS = {"levels": "a difference between sources or levels that no candidate makes",
+OUTSIDE_FORMS = {"levels": ("a difference between sources or levels, or an error alike on "
+                            "all of them, that no candidate makes"),
                  "velocity": "a difference between travel velocities (no candidate depends on "
                              "the velocity)",
                  "drift": "a soil that drifts through the campaign (read from the runs' start "
@@ -243,15 +241,23 @@ OUTSIDE_FORMS = {"levels": "a difference between sources or levels that no candi
 
 
 def outside_forms(sim: Simulated, points: pd.DataFrame, obs, amplitudes: np.ndarray,
-                  soil: MapFit) -> dict[str, tuple]:
+                  soil: MapFit, free_levels: list[np.ndarray]) -> dict[str, tuple]:
     """The forms of the hypothesis "an effect outside the candidates", each the observations
     with its second discrepancy and that discrepancy's sizes: apart per source and level
-    (sized as the candidate effects are, ``amplitudes``, as are the other forms); apart per
+    (sized as the candidate effects are, ``amplitudes``, as are the other forms), or common
+    to every source and level where the sources and levels differ in one level effect's
+    factor alone (``free_levels``: the levels of each effect with a free form,
+    :func:`free_forms`): what differs between the levels of that factor is that effect by
+    definition, and its free form is the same model on the same bases, so an effect outside
+    the candidates is what acts alike on every level there; apart per
     set travel velocity, where the runs have two or more (no candidate law depends on the
     velocity, so a rate effect in the soil or the rig is outside them); a soil that drifts
     through the campaign (:func:`sim_gap.evidence.soil_drift`), where every run's start
     time is known. One size prior for every form: an effect outside the candidates is a
     priori as large as the candidate effects are, whatever its form."""
+    groups = level_groups(points)
+    if any(same_partition(groups, levels) for levels in free_levels):
+        obs = apart_by(obs, np.zeros(len(points)))
     forms = {"levels": (obs, amplitudes)}
     if "velocity_set_mps" in points:
         velocity = points["velocity_set_mps"].to_numpy(float).round(6)
@@ -399,10 +405,13 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     candidate_of = {k: f.fit.candidate for k, f in fits.items()}
     amplitudes = outside_amplitudes(sim, points, obs, single_list)
     bags = {k: _bag(sim, obs, cov, f, evidence[k]) for k, f in fits.items()}
-    for key, (c, base, e, bag) in free_forms(sim, points, obs, fits, reference,
+    free_levels = {e: levels for e in reference if e in cands.LEVEL_FACTOR
+                   and (levels := _levels(points, e)) is not None}
+    for key, (c, base, e, bag) in free_forms(sim, obs, fits, reference, free_levels,
                                              amplitudes).items():
         candidate_of[key], fits[key], evidence[key], bags[key] = c, base, e, bag
-    forms = outside_forms(sim, points, obs, amplitudes, fits["soil_only"])
+    forms = outside_forms(sim, points, obs, amplitudes, fits["soil_only"],
+                          list(free_levels.values()))
     fits[OUTSIDE], evidence[OUTSIDE], outside_bags, form_shares, outside_effects = outside(
         sim, obs, forms, fits, reference, len(allowed))
     prior = hypothesis_priors(list(candidate_of.values()), len(allowed))

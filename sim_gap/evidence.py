@@ -120,16 +120,27 @@ def observations(points: pd.DataFrame, sigma: dict[str, np.ndarray], radius_m: f
     sig = np.column_stack([sigma[q] for q in quantities])
     floor = floor_by_q[point, qi]
     shared = _unit_kernel(points, point, qi, floor)
-    group = pd.factorize(pd.Series(list(zip(
-        points["source"] if "source" in points else [""] * len(points),
-        points["multipass"].to_numpy(int), points["gravity_mps2"].round(6))),
-        dtype=object))[0][point]
+    group = level_groups(points)[point]
     grouped = np.where(group[:, None] == group[None, :], shared, 0.0)
     offsets = np.zeros((point.size, 0))
     if points.attrs.get("sinkage_relative") and "sinkage_m" in quantities:
         offsets = (qi == quantities.index("sinkage_m")).astype(float)[:, None]
     return Observations(values[where], sig[where], floor, point, qi, where, shared, grouped,
                         offsets)
+
+
+def level_groups(points: pd.DataFrame) -> np.ndarray:
+    """Per point, the index of its source, multipass level and gravity level together."""
+    return pd.factorize(pd.Series(list(zip(
+        points["source"] if "source" in points else [""] * len(points),
+        points["multipass"].to_numpy(int), points["gravity_mps2"].round(6))),
+        dtype=object))[0]
+
+
+def same_partition(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether labels ``a`` and ``b`` (one per point) group the points alike."""
+    pairs = pd.Series(list(zip(a.tolist(), b.tolist())), dtype=object)
+    return pairs.nunique() == pd.Series(a).nunique() == pd.Series(b).nunique()
 
 
 def apart_by(obs: Observations, levels: np.ndarray) -> Observations:
