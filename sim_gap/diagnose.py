@@ -257,7 +257,7 @@ def outside_forms(sim: Simulated, points: pd.DataFrame, obs, amplitudes: np.ndar
     priori as large as the candidate effects are, whatever its form."""
     groups = level_groups(points)
     if any(same_partition(groups, levels) for levels in free_levels):
-        obs = apart_by(obs, np.zeros(len(points)))
+        obs = replace(obs, kernel_grouped=obs.kernel_shared)
     forms = {"levels": (obs, amplitudes)}
     if "velocity_set_mps" in points:
         velocity = points["velocity_set_mps"].to_numpy(float).round(6)
