@@ -9,8 +9,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import savgol_filter
-
 from swtlab_base.order_stats import median
 
 #: relative error aimed at for a derivative at the stream's typical speed
@@ -80,6 +78,28 @@ def choose_window_s(stats: dict) -> float:
     return float(min(max(w_noise, w_steps, w_min), WINDOW_MAX_S))
 
 
+def savgol_slopes(y: np.ndarray, window: int, delta: float) -> np.ndarray:
+    """First derivative by a local quadratic least-squares fit over ``window`` samples
+    (Savitzky & Golay 1964, Anal. Chem. 36:1627); ``len(y) >= window``, window odd.
+
+    Inside, the slope of the quadratic at the centre equals the straight-line slope
+    sum(k*y_k)/sum(k^2); the first and last half-windows take the derivative of the
+    quadratic fitted to the first or last window at their own positions (scipy's
+    ``savgol_filter(..., mode="interp")``).
+    """
+    half = window // 2
+    k = np.arange(-half, half + 1, dtype=float)
+    out = np.empty(len(y))
+    out[half:len(y) - half] = np.correlate(y, k / np.dot(k, k), mode="valid")
+    x = np.arange(window, dtype=float) - half
+    basis = np.vander(x, POLYORDER + 1, increasing=True)
+    coef = np.linalg.lstsq(basis, np.stack([y[:window], y[-window:]], axis=1), rcond=None)[0]
+    slope_at = coef[1][None, :] + 2.0 * coef[2][None, :] * x[:, None]
+    out[:half] = slope_at[:half, 0]
+    out[len(y) - half:] = slope_at[half + 1:, 1]
+    return out / delta
+
+
 def savgol_derivative(y: np.ndarray, rate_hz: float, window_s: float) -> tuple[np.ndarray, int]:
     """d/dt of a uniformly sampled signal, segment by segment between NaN gaps.
 
@@ -91,8 +111,7 @@ def savgol_derivative(y: np.ndarray, rate_hz: float, window_s: float) -> tuple[n
     edges = np.flatnonzero(np.diff(np.r_[0, finite.astype(np.int8), 0]))
     for start, stop in zip(edges[::2], edges[1::2]):
         if stop - start >= window:
-            out[start:stop] = savgol_filter(y[start:stop], window, POLYORDER, deriv=1,
-                                            delta=1.0 / rate_hz, mode="interp")
+            out[start:stop] = savgol_slopes(y[start:stop], window, 1.0 / rate_hz)
     return out, window
 
 

@@ -74,6 +74,17 @@ def test_derivative_is_nan_in_gaps_and_short_segments():
     np.testing.assert_allclose(rate[620:], 10.0, rtol=1e-9)
 
 
+@pytest.mark.parametrize("n, window", [(5, 5), (6, 5), (101, 21), (2000, 51)])
+def test_savgol_slopes_match_scipy_savgol_filter(n, window):
+    """The library's own Savitzky-Golay derivative, edges included, against scipy's."""
+    from scipy.signal import savgol_filter
+
+    y = np.cumsum(np.random.default_rng(n).normal(size=n)) + 50.0
+    expected = savgol_filter(y, window, derive.POLYORDER, deriv=1, delta=0.004, mode="interp")
+    got = derive.savgol_slopes(y, window, 0.004)
+    assert np.allclose(got, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
+
+
 def test_slip_driving_skid_and_undefined():
     rw = np.array([0.2, 0.1, 0.0, 0.1, 0.0, 1e-5, 0.1])
     v = np.array([0.15, 0.2, 0.1, 0.1, 0.0, 0.0, -0.1])

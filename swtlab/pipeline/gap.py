@@ -59,12 +59,13 @@ class GapReport:
               html_path: str | Path | None = None) -> None:
         """Write the JSON and the self-contained HTML page (the campaign report's gap
         section on a page of its own) where asked."""
-        from campaign_report.gap import write_gap_page
         from sim_gap.report import write_json
 
         if json_path:
             write_json(self.data, json_path)
         if html_path:
+            from campaign_report.gap import write_gap_page  # matplotlib: only for a page
+
             write_gap_page(self.typed, html_path)
 
 
