@@ -313,14 +313,24 @@ def _sample(field_px: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     return inner + ex * (x - xc) + ey * (y - yc)
 
 
-def _upsample(map_px: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Bilinear sample of a smooth map at supersample points within half a pixel of the frame.
+def _upsample(map_px: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """Bilinear sample of a smooth map on the grid of supersample points ``xs`` (columns) by
+    ``ys`` (rows), all within half a pixel of the frame: rows first, then columns (the grid is
+    separable, so this is ``ndimage.map_coordinates(order=1)`` at the grid's points).
 
     The map is padded by one linearly extrapolated pixel; its curvature is < 1e-3
     px/px^2, so bilinear interpolation errs < 1e-4 px.
     """
     padded = np.pad(map_px, 1, mode="reflect", reflect_type="odd")
-    return ndimage.map_coordinates(padded, [y + 1, x + 1], order=1)
+
+    def cell(u: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+        i = np.clip(np.floor(u + 1).astype(np.intp), 0, n - 2)
+        return i, u + 1 - i
+
+    iy, fy = cell(ys, padded.shape[0])
+    ix, fx = cell(xs, padded.shape[1])
+    rows = padded[iy] * (1 - fy)[:, None] + padded[iy + 1] * fy[:, None]
+    return rows[:, ix] * (1 - fx) + rows[:, ix + 1] * fx
 
 
 def _box_down(img: np.ndarray, s: int) -> np.ndarray:
@@ -401,7 +411,7 @@ def render_flow(scene: FlowScene, n_frames: int = 4) -> FlowRender:
                 bx, by = tx - ux, ty - uy
             qx0 = _sample(qx0, bx, by)
             qy0 = _sample(qy0, bx, by)
-        qx, qy = _upsample(qx0, XS, YS), _upsample(qy0, XS, YS)
+        qx, qy = _upsample(qx0, xs, ys), _upsample(qy0, xs, ys)
         soil = ndimage.map_coordinates(coeffs, [(qy + margin) * s + (s - 1) / 2,
                                                 (qx + margin) * s + (s - 1) / 2],
                                        order=3, prefilter=False, mode="mirror")
