@@ -19,6 +19,7 @@ import numpy as np
 from scipy.ndimage import map_coordinates, maximum_filter1d, uniform_filter1d
 
 STEP_PX = 0.5  # along-track sampling of the profile
+BAND_BLOCK_ROWS = 64  # first rows of the bands find_band scores at once (memory, not results)
 
 
 @dataclass(frozen=True)
@@ -122,12 +123,16 @@ def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int
     z = _row_demodulation(strip, freq_per_sample)[first:last] * n
     total = np.concatenate([[0.0], np.cumsum(z)])
     count = np.concatenate([[0], np.cumsum(n)])
-    lo = np.arange(z.size)[:, None]
-    hi = np.arange(z.size + 1)[None, :]
-    snr = (np.abs(total[hi] - total[lo]) / np.sqrt(np.maximum(count[hi] - count[lo], 1))
-           * (hi - lo >= 3))
-    lo_best, hi_best = np.unravel_index(int(np.argmax(snr)), snr.shape)
-    return int(first + lo_best), int(first + hi_best), float(snr[lo_best, hi_best])
+    best, lo_best, hi_best = 0.0, 0, 0
+    for start in range(0, z.size - 2, BAND_BLOCK_ROWS):  # bands [lo, hi) with hi >= lo + 3
+        lo = np.arange(start, min(start + BAND_BLOCK_ROWS, z.size))[:, None]
+        hi = np.arange(start + 3, z.size + 1)[None, :]
+        snr = np.abs(total[hi] - total[lo]) / np.sqrt(np.maximum(count[hi] - count[lo], 1))
+        snr[hi - lo < 3] = 0.0
+        row, col = divmod(int(np.argmax(snr)), snr.shape[1])
+        if snr[row, col] > best:  # the first of equal maxima, as one argmax over all bands
+            best, lo_best, hi_best = float(snr[row, col]), start + row, start + 3 + col
+    return int(first + lo_best), int(first + hi_best), best
 
 
 def shear_slope(strip: Strip, lo: int, hi: int, freq_per_sample: float) -> float:
