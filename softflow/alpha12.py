@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.special import stdtrit
 
 from softflow.decay_fit import DecayFit
 
@@ -24,23 +25,19 @@ MIN_R2 = 0.5  # k fits below this are not used (as for the grouser models)
 
 def rates_and_sigmas(fits: Sequence[DecayFit | None]) -> tuple[np.ndarray, np.ndarray]:
     """``k`` and its standard error (from the 95 % CI) per bin; NaN where unusable."""
-    from scipy import stats  # here: reading a stored flow does not need scipy.stats
-
     k = np.full(len(fits), np.nan)
     sigma = np.full(len(fits), np.nan)
     for i, f in enumerate(fits):
         if f and f.r2 > MIN_R2 and f.rate_per_m > 0 and f.dof > 0:
             k[i] = f.rate_per_m
             half = (f.ci95_per_m[1] - f.ci95_per_m[0]) / 2
-            sigma[i] = half / stats.t.ppf(0.975, f.dof)
+            sigma[i] = half / stdtrit(f.dof, 0.975)
     return k, sigma
 
 
 def fit_alpha12(eps: np.ndarray, k_per_m: np.ndarray, k_sigma_per_m: np.ndarray) -> dict | None:
     """``alpha1_per_m``, ``alpha2``, ``bins_used``, their 95 % CIs and ``eps_range``; None
     with fewer than 3 usable pairs."""
-    from scipy import stats
-
     eps, k, sk = (np.asarray(a, np.float64) for a in (eps, k_per_m, k_sigma_per_m))
     ok = np.isfinite(eps) & np.isfinite(k) & np.isfinite(sk) & (k > 0)
     n = int(ok.sum())
@@ -55,7 +52,7 @@ def fit_alpha12(eps: np.ndarray, k_per_m: np.ndarray, k_sigma_per_m: np.ndarray)
         return None
     resid = y - a - b * x
     cov = np.linalg.inv(normal) * float(np.sum(w * resid ** 2)) / max(n - 2, 1)
-    t = stats.t.ppf(0.975, max(n - 2, 1))
+    t = stdtrit(max(n - 2, 1), 0.975)
     alpha1, alpha2 = 1 / b, a / b
     sd1 = np.sqrt(cov[1, 1]) / b ** 2
     sd2 = np.sqrt(max(cov[0, 0] / b ** 2 + a ** 2 * cov[1, 1] / b ** 4

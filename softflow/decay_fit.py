@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import curve_fit
+from scipy.special import stdtrit
 
 MAX_EXPONENT = 700.0  # exp(700) ~ 1e304, below float64's overflow
 
@@ -51,8 +52,6 @@ def _model(rho, a, k):
 
 def fit_decay(rho_m: np.ndarray, value: np.ndarray, sigma: np.ndarray) -> DecayFit | None:
     """Fit one profile; ``None`` with fewer than 5 points or no convergence."""
-    from scipy import stats  # here: reading a stored flow does not need scipy.stats
-
     if len(rho_m) < 5:
         return None
     a0 = value[np.argmin(rho_m)]
@@ -66,7 +65,7 @@ def fit_decay(rho_m: np.ndarray, value: np.ndarray, sigma: np.ndarray) -> DecayF
     except (RuntimeError, ValueError):
         return None
     dof = len(rho_m) - 2
-    half = stats.t.ppf(0.975, dof) * float(np.sqrt(max(cov[1, 1], 0.0)))
+    half = stdtrit(dof, 0.975) * float(np.sqrt(max(cov[1, 1], 0.0)))
     w = 1 / sigma ** 2
     resid = value - _model(rho_m, a, k)
     mean = np.sum(w * value) / np.sum(w)
@@ -82,7 +81,6 @@ def fit_decay_across(rho_m: list, value: list, sigma: list, offsets_rad: np.ndar
     scaled covariance (``t(0.975, n - p)``), the R² and point count of the centre's own profile.
     ``None`` when the centre profile cannot be fitted alone (:func:`fit_decay`) or the joint fit
     does not converge; with fewer than three profiles, the centre's own fit."""
-    from scipy import stats
     from scipy.optimize import least_squares
 
     own = fit_decay(rho_m[centre], value[centre], sigma[centre])
@@ -92,15 +90,30 @@ def fit_decay_across(rho_m: list, value: list, sigma: list, offsets_rad: np.ndar
     rho, val, sig = (np.concatenate(x) for x in (rho_m, value, sigma))
     dbeta = np.asarray(offsets_rad, float)[which]
 
-    def resid(p):
+    def decay(p):
         # a trial step far below zero rate would overflow exp: capped, it is a worse step
         # that Levenberg-Marquardt rejects as it would an infinite one
-        exponent = np.minimum(-(p[0] + p[1] * dbeta) * rho, MAX_EXPONENT)
-        return (p[2:][which] * np.exp(exponent) - val) / sig
+        exponent = -(p[0] + p[1] * dbeta) * rho
+        return np.exp(np.minimum(exponent, MAX_EXPONENT)), exponent < MAX_EXPONENT
+
+    def resid(p):
+        return (p[2:][which] * decay(p)[0] - val) / sig
+
+    rows = np.arange(len(val))
+
+    def jacobian(p):
+        """d resid / d (k, s, A_0 ...): the exponent's slopes where it is not capped."""
+        e, free = decay(p)
+        d_rate = -p[2:][which] * e * rho * free / sig
+        out = np.zeros((len(val), len(p)))
+        out[:, 0], out[:, 1] = d_rate, d_rate * dbeta
+        out[rows, 2 + which] = e / sig
+        return out
 
     start = [v[np.argmin(r)] for r, v in zip(rho_m, value)]
     start[centre] = own.amplitude
-    sol = least_squares(resid, np.r_[own.rate_per_m, 0.0, start], method="lm", max_nfev=4000)
+    sol = least_squares(resid, np.r_[own.rate_per_m, 0.0, start], jac=jacobian, method="lm",
+                        max_nfev=4000)
     dof = len(val) - len(sol.x)
     if not sol.success or dof < 1:
         return None
@@ -109,7 +122,7 @@ def fit_decay_across(rho_m: list, value: list, sigma: list, offsets_rad: np.ndar
     except np.linalg.LinAlgError:
         return None
     k, a = float(sol.x[0]), float(sol.x[2 + centre])
-    half = stats.t.ppf(0.975, dof) * float(np.sqrt(max(cov[0, 0], 0.0)))
+    half = stdtrit(dof, 0.975) * float(np.sqrt(max(cov[0, 0], 0.0)))
     r, v, s = rho_m[centre], value[centre], sigma[centre]
     w = 1 / s ** 2
     mean = np.sum(w * v) / np.sum(w)

@@ -18,6 +18,7 @@ from dataclasses import replace
 
 import cv2
 import numpy as np
+from scipy.special import stdtrit
 
 from softflow.alpha12 import fit_alpha12, rates_and_sigmas
 from softflow.decay_fit import DecayFit, fit_decay_across
@@ -225,8 +226,6 @@ def jackknife_ci(radial: list, tangential: list, mean: MeanField, sled: np.ndarr
     contact bins, the jackknife's in 97 %. The sled velocity is held at its final value. A bin
     where a leave-one-out fit fails gets an infinite CI (the checks then drop it). Fewer than
     ``MIN_JACKKNIFE_PAIRS`` pairs: the fits as they are."""
-    from scipy import stats  # here: reading a stored flow does not need scipy.stats
-
     pairs = mean.pair_velocities_px_per_s
     n_pairs = len(pairs)
     if n_pairs < MIN_JACKKNIFE_PAIRS:
@@ -248,7 +247,7 @@ def jackknife_ci(radial: list, tangential: list, mean: MeanField, sled: np.ndarr
             for j, f in enumerate(refits):
                 if f is not None:
                     rates[i, c, j] = f.rate_per_m
-    t = stats.t.ppf(0.975, n_pairs - 1)
+    t = stdtrit(n_pairs - 1, 0.975)
     out = []
     for c, fits in enumerate((radial, tangential)):
         k = rates[:, c]

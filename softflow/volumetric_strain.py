@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage
+from scipy.special import stdtrit
 
 from softflow.flow_engine import BORDER_PX  # dropped at the image edge: windows cut by it
 
@@ -177,8 +178,6 @@ def strain_by_beta(velocity_px_per_s: np.ndarray, center_px: tuple[float, float]
 
     ``velocity_px_per_s``: mean camera-frame field (H, W, 2), NaN where masked.
     """
-    from scipy import stats  # here: reading a stored flow does not need scipy.stats
-
     args = (velocity_px_per_s, center_px, radius_px, beta_centres, width_rad,
             far_velocity_px_per_s)
     samples, left = _bin_samples(*args, sigma_px)
@@ -186,7 +185,7 @@ def strain_by_beta(velocity_px_per_s: np.ndarray, center_px: tuple[float, float]
     eps = _bin_mean(samples)
     count = np.isfinite(samples).sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        scatter = (stats.t.ppf(0.975, np.maximum(count - 1, 1))
+        scatter = (stdtrit(np.maximum(count - 1, 1), 0.975)
                    * np.nanstd(np.where(count[:, None] >= 3, samples, 0.0), axis=1, ddof=1)
                    / np.sqrt(np.maximum(count, 1)))
         bound = np.abs(coarse - eps) + scatter + np.nanmean(
