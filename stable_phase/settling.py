@@ -57,9 +57,22 @@ class _Exponential:
         return a + b * self._decay
 
 
-def _repeated_pole(t, a, b, c, tau, t0):
-    x = np.clip(t - t0, 0.0, None) / tau
-    return a + (b + c * x) * np.exp(-x)
+class _RepeatedPole:
+    """``a + (b + c x) exp(-x)``, ``x = max(t - t_on, 0)/tau``, keeping ``x`` and ``exp(-x)`` of
+    the last ``(t, tau, t_on)`` as :class:`_Exponential` does (steps in ``a``, ``b``, ``c``)."""
+
+    def __init__(self):
+        self._key: tuple | None = None
+        self._x: np.ndarray | None = None
+        self._decay: np.ndarray | None = None
+
+    def __call__(self, t, a, b, c, tau, t0):
+        key = self._key
+        if key is None or key[0] is not t or key[1] != tau or key[2] != t0:
+            self._x = np.clip(t - t0, 0.0, None) / tau
+            self._decay = np.exp(-self._x)
+            self._key = (t, tau, t0)
+        return a + (b + c * self._x) * self._decay
 
 
 def _fit(model, t, y, p0, lower, upper):
@@ -95,7 +108,7 @@ def fit_settling(t_s: np.ndarray, y: np.ndarray, double_pole: bool = True) -> di
     c = 0.0
     starts = [(a, b, b * c_ratio, tau * tau_ratio, t0)
               for c_ratio, tau_ratio in (DOUBLE_STARTS if double_pole else ())]
-    fits = [f for f in (_fit(_repeated_pole, t, y, p0, [-np.inf, -np.inf, -np.inf, 1e-3 * span,
+    fits = [f for f in (_fit(_RepeatedPole(), t, y, p0, [-np.inf, -np.inf, -np.inf, 1e-3 * span,
                                                          0.0],
                              [np.inf, np.inf, np.inf, 2.0 * span, 0.5 * span]) for p0 in starts)
             if f is not None]
