@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from swtlab_base.order_stats import median
 
 #: relative error aimed at for a derivative at the stream's typical speed
