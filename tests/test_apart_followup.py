@@ -11,7 +11,8 @@ import json
 import pytest
 
 from testbeds.apart.campaign import draw_campaign, write_campaign_folder
-from testbeds.apart.followup import followup_rows, resolved, write_followup
+from testbeds.apart.followup import (followup_rows, followup_start_times, resolved,
+                                     write_followup)
 
 G0 = 9.80665
 
@@ -48,6 +49,28 @@ def test_followup_runs_are_the_same_campaigns_at_the_proposed_conditions():
     # same campaign, same arm: the same runs
     again, _ = followup_rows(drawn, conditions, "top")
     assert [r["steady"]["dp_n"] for r in again] == [r["steady"]["dp_n"] for r in rows]
+
+
+
+def test_followup_runs_start_after_the_campaigns_last_run_one_after_the_other():
+    """A lab's log: the follow-up comes after the campaign (whose soil its truth holds, the
+    campaign's end), not in a block months away that a drift in time could take."""
+    from datetime import datetime
+
+    from testbeds.apart.campaign import lab_rig, start_times
+
+    index, drawn = _lugged_campaign()
+    load = float(drawn["plan"].loads_n[0])
+    conditions = [{"source": "x", "load_set_n": load, "slip": s, "multipass": 0,
+                   "gravity_mps2": G0} for s in (0.2, 0.5)]
+    rows, _ = followup_rows(drawn, conditions, "top")
+    run_s = lab_rig(drawn["seed"], drawn["index"], drawn["plan"]).timeline.duration_s
+    campaign = [datetime.fromisoformat(t) for t in
+                start_times(drawn["seed"], drawn["index"], drawn["plan"], run_s).values()]
+    started = [datetime.fromisoformat(t) for t in followup_start_times(drawn, rows).values()]
+    gap_s = run_s + 60.0 * 12.0  # a run and the reset between runs
+    assert (started[0] - max(campaign)).total_seconds() == pytest.approx(gap_s)
+    assert (started[1] - started[0]).total_seconds() == pytest.approx(gap_s)
 
 
 def test_written_followup_holds_the_campaign_and_the_new_runs(tmp_path):

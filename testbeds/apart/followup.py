@@ -27,12 +27,14 @@ import sys
 import tempfile
 import zlib
 from dataclasses import replace
+from datetime import datetime, timedelta
 from pathlib import Path
 
 import numpy as np
 
-from testbeds.apart.campaign import (campaign_names, draw_campaign, lab_rig, rig_inputs,
-                                     run_row, truth_document, write_text)
+from testbeds.apart.campaign import (RESET_MIN, campaign_names, draw_campaign, lab_rig,
+                                     rig_inputs, run_row, start_times, truth_document,
+                                     write_text)
 from testbeds.apart.effects import SIX
 from testbeds.apart.score import diagnose, score_campaign
 from testbeds.apart.solver import NoEquilibrium
@@ -80,6 +82,18 @@ def followup_rows(drawn: dict, conditions: list[dict], tag: str) -> tuple[list[d
     return rows, failed
 
 
+def followup_start_times(drawn: dict, rows: list[dict]) -> dict[str, str]:
+    """When each follow-up run started: one after the other from the campaign's last run on,
+    as :func:`testbeds.apart.campaign.start_times` spaces a campaign's runs (their truth is the
+    soil at the campaign's end, run order 1.0). A lab's log shows the same."""
+    plan = drawn["plan"]
+    run_s = lab_rig(drawn["seed"], drawn["index"], plan).timeline.duration_s
+    last = max(datetime.fromisoformat(t)
+               for t in start_times(drawn["seed"], drawn["index"], plan, run_s).values())
+    step = timedelta(seconds=run_s + 60.0 * RESET_MIN)
+    return {r["run"].run_id: (last + (k + 1) * step).isoformat() for k, r in enumerate(rows)}
+
+
 def write_followup(src: Path, out: Path, truth: dict, tag: str, test: dict) -> dict:
     """``src`` (a campaign folder) plus the runs of ``test`` (a report's ``{test,
     conditions}``) as ``out/<campaign>_<tag>``; its truth (the campaign's, with the new runs
@@ -94,13 +108,15 @@ def write_followup(src: Path, out: Path, truth: dict, tag: str, test: dict) -> d
     runs = plan.runs + tuple((r["source"], r["run"]) for r in rows)
     rig = lab_rig(drawn["seed"], drawn["index"], replace(plan, runs=runs))
     names = campaign_names(name, plan)
+    started = followup_start_times(drawn, rows)
     for source, part in (("main", folder), ("smooth", folder / "smooth")):
         mine = [r for r in rows if r["source"] == source]
         if not mine:
             continue
         with tempfile.TemporaryDirectory(dir=out) as staging:
             write_campaign(staging, *rig_inputs(mine, names[source]),
-                           drawn["seed"] * 1000 + drawn["index"] + 500, rig=rig)
+                           drawn["seed"] * 1000 + drawn["index"] + 500, rig=rig,
+                           started_at=started)
             (part / "campaign").mkdir(parents=True, exist_ok=True)
             for f in (Path(staging) / "campaign").iterdir():
                 shutil.move(str(f), str(part / "campaign" / f.name))
