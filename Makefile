@@ -18,7 +18,7 @@ system-deps:
 
 # Exact versions (with hashes) from requirements.lock, then swtlab itself without resolving.
 # The installer is uv (pinned with its hashes in requirements-uv.lock): it fetches and unpacks
-# in parallel, a fresh environment in about 25 s where pip takes about 80 s.
+# in parallel, a fresh environment in about 35 s where pip takes about 80 s.
 $(STAMP): pyproject.toml setup.py requirements.lock requirements-uv.lock $(wildcard libswtwpm/*.c libswtwpm/*.h) | system-deps
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --require-hashes -r requirements-uv.lock

@@ -40,39 +40,38 @@ FIT_POINTS = 5000
 DOUBLE_STARTS = ((0.0, 1.0), (-1.0, 1.0), (-1.0, 2.0), (-2.0, 2.0))
 
 
-class _Exponential:
-    """``a + b exp(-max(t - t_on, 0)/tau)``, keeping the decay of the last ``(t, tau, t_on)``:
-    curve_fit's finite-difference steps in ``a`` and ``b`` reuse it (the same numbers as
-    computing it again, without two of every four exponentials of its Jacobian)."""
-
-    def __init__(self):
-        self._key: tuple | None = None
-        self._decay: np.ndarray | None = None
-
-    def __call__(self, t, a, b, tau, t0):
-        key = self._key
-        if key is None or key[0] is not t or key[1] != tau or key[2] != t0:
-            self._decay = np.exp(-np.maximum(t - t0, 0.0) / tau)
-            self._key = (t, tau, t0)
-        return a + b * self._decay
-
-
-class _RepeatedPole:
-    """``a + (b + c x) exp(-x)``, ``x = max(t - t_on, 0)/tau``, keeping ``x`` and ``exp(-x)`` of
-    the last ``(t, tau, t_on)`` as :class:`_Exponential` does (steps in ``a``, ``b``, ``c``)."""
+class _Decay:
+    """``x = max(t - t_on, 0)/tau`` and ``exp(-x)`` of the last ``(t, tau, t_on)``, kept:
+    curve_fit's finite-difference steps in the linear parameters reuse them (the same
+    numbers as computing them again, without most of the exponentials of its Jacobian)."""
 
     def __init__(self):
         self._key: tuple | None = None
         self._x: np.ndarray | None = None
         self._decay: np.ndarray | None = None
 
-    def __call__(self, t, a, b, c, tau, t0):
+    def decay(self, t, tau, t0) -> tuple[np.ndarray, np.ndarray]:
         key = self._key
         if key is None or key[0] is not t or key[1] != tau or key[2] != t0:
-            self._x = np.clip(t - t0, 0.0, None) / tau
+            self._x = np.maximum(t - t0, 0.0) / tau
             self._decay = np.exp(-self._x)
             self._key = (t, tau, t0)
-        return a + (b + c * self._x) * self._decay
+        return self._x, self._decay
+
+
+class _Exponential(_Decay):
+    """``a + b exp(-max(t - t_on, 0)/tau)``."""
+
+    def __call__(self, t, a, b, tau, t0):
+        return a + b * self.decay(t, tau, t0)[1]
+
+
+class _RepeatedPole(_Decay):
+    """``a + (b + c x) exp(-x)``, ``x = max(t - t_on, 0)/tau``."""
+
+    def __call__(self, t, a, b, c, tau, t0):
+        x, decay = self.decay(t, tau, t0)
+        return a + (b + c * x) * decay
 
 
 def _fit(model, t, y, p0, lower, upper):

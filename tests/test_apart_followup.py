@@ -57,7 +57,7 @@ def test_followup_runs_start_after_the_campaigns_last_run_one_after_the_other():
     campaign's end), not in a block months away that a drift in time could take."""
     from datetime import datetime
 
-    from testbeds.apart.campaign import lab_rig, start_times
+    from testbeds.apart.campaign import RESET_MIN, lab_rig, start_times
 
     index, drawn = _lugged_campaign()
     load = float(drawn["plan"].loads_n[0])
@@ -68,7 +68,7 @@ def test_followup_runs_start_after_the_campaigns_last_run_one_after_the_other():
     campaign = [datetime.fromisoformat(t) for t in
                 start_times(drawn["seed"], drawn["index"], drawn["plan"], run_s).values()]
     started = [datetime.fromisoformat(t) for t in followup_start_times(drawn, rows).values()]
-    gap_s = run_s + 60.0 * 12.0  # a run and the reset between runs
+    gap_s = run_s + 60.0 * RESET_MIN  # a run and the reset between runs
     assert (started[0] - max(campaign)).total_seconds() == pytest.approx(gap_s)
     assert (started[1] - started[0]).total_seconds() == pytest.approx(gap_s)
 
