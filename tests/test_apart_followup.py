@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from testbeds.apart.campaign import draw_campaign, write_campaign_folder
-from testbeds.apart.followup import (followup_rows, followup_start_times, resolved,
-                                     write_followup)
+from testbeds.apart.followup import (by_kind, followup_rows, followup_start_times, main,
+                                     resolved, kind_of, write_followup)
 
 G0 = 9.80665
 
@@ -108,3 +109,36 @@ def test_written_followup_holds_the_campaign_and_the_new_runs(tmp_path):
 ])
 def test_resolved_means_a_right_call(truth, row, expected):
     assert resolved(row, truth) is expected
+
+
+@pytest.mark.parametrize("slips, expected", [
+    ((-0.4, -0.2, -0.1), "braked slips"), ((0.03, 0.08, 0.15), "low slips"),
+    ((0.6, 0.75, 0.9), "high slips"), ((-0.1, 0.6), "low slips")])
+def test_a_slip_test_is_named_by_its_band(slips, expected):
+    test = {"kind": "slips", "conditions": [{"slip": s} for s in slips]}
+    assert kind_of(test) == expected
+    assert kind_of({"kind": "smooth wheel", "conditions": []}) == "smooth wheel"
+
+
+def _result(p_before, top, random):
+    arm = {"top": top, "random": random}
+    return {"p_true": p_before, **{k: {"kind": v[0], "gain_bits": v[1], "p_true": v[2],
+                                       "resolved": v[2] >= 0.9} for k, v in arm.items()}}
+
+
+def test_by_kind_pools_both_arms_and_counts_what_the_truth_did(tmp_path, capsys):
+    results = [_result(0.5, ("high slips", 1.0, 0.25), ("gravity", 0.2, 0.95)),
+               _result(0.4, ("high slips", 0.6, 0.4), ("high slips", 0.8, 0.8))]
+    table = {k["kind"]: k for k in by_kind(results)}
+    high = table["high slips"]
+    assert high["n"] == 3 and high["gain_bits"] == pytest.approx(0.8)
+    assert high["median_log_change"] == pytest.approx(0.0)  # ln(0.5), 0, ln(2): median 0
+    assert (high["rises"], high["resolved"]) == (1, 0)
+    assert table["gravity"]["median_log_change"] == pytest.approx(np.log(0.95 / 0.5))
+    assert (table["gravity"]["rises"], table["gravity"]["resolved"]) == (1, 1)
+    kept = tmp_path / "fu.json"
+    kept.write_text(json.dumps({"campaigns": results}))
+    assert main(["--summarise", str(kept)]) == 0
+    printed = capsys.readouterr().out
+    assert "| top | 0 / 2 | 0 / 2 |" in printed and "| random | 1 / 2 | 2 / 2 |" in printed
+    assert "| high slips | 3 | 0.80 | +0.00 | 1 | 0 |" in printed

@@ -1,5 +1,6 @@
 """Follow-up tests on the apart testbed's inconclusive campaigns: ``python -m
-testbeds.apart.followup DIR --out OUT [--seed S] [--only cNNN,...] [--boot B]``.
+testbeds.apart.followup DIR --out OUT [--seed S] [--only cNNN,...] [--boot B] [--json F]``;
+``--summarise F [F ...]`` prints the tables of kept results (:func:`markdown`).
 
 For each campaign ``DIR/cNNN`` whose report (``gap.json``, diagnosed again from the processed
 databases when it lists no ``admissible_tests``) is ``inconclusive``, two follow-ups are
@@ -42,6 +43,9 @@ from testbeds.apart.truth import REFERENCE_VELOCITY_MPS, RunSpec, WheelSpec
 from validation.second_rig import write_campaign
 
 ARMS = ("top", "random")
+#: a probability below this counts as this in a log (the scorer's floor,
+#: :func:`testbeds.apart.score.calibration`)
+P_FLOOR = 1e-12
 #: the files of a campaign folder a follow-up does not copy (the diagnosis' outputs)
 NOT_COPIED = ("*.sqlite", "gap*.json", "gap*.html", "failure.txt")
 
@@ -141,6 +145,53 @@ def resolved(row: dict, truth: dict) -> bool:
         e for e in SIX if e in truth["effects"]) and row["outcome"] == "right"
 
 
+def kind_of(test: dict) -> str:
+    """The report's kind of ``test`` (a report's ``{kind, conditions}``), a slip test named by
+    its band: braked (every slip below zero), high (every slip from 0.5 up) or low."""
+    if test["kind"] != "slips":
+        return test["kind"]
+    slips = [c["slip"] for c in test["conditions"]]
+    band = "braked" if max(slips) < 0 else "high" if min(slips) >= 0.5 else "low"
+    return f"{band} slips"
+
+
+def by_kind(results: list[dict]) -> list[dict]:
+    """Per kind of test (both arms pooled): how often it was run, its mean expected gain and
+    what it did to the truth's probability (median change of its log, how often it rose,
+    how often it resolved). Under a model that holds, the truth's log probability rises on
+    average with any test (the expected log posterior of the truth grows with data); a kind
+    whose runs lower it tells the hypotheses apart by what the base model gets wrong."""
+    rows: dict[str, list] = {}
+    for r in results:
+        for arm in ARMS:
+            a = r[arm]
+            change = np.log(max(a["p_true"], P_FLOOR)) - np.log(max(r["p_true"], P_FLOOR))
+            rows.setdefault(a["kind"], []).append((a["gain_bits"], change, a["resolved"]))
+    out = []
+    for kind, v in sorted(rows.items(), key=lambda kv: -len(kv[1])):
+        gain, change, done = (np.array(x, float) for x in zip(*v))
+        out.append({"kind": kind, "n": len(v), "gain_bits": float(gain.mean()),
+                    "median_log_change": float(np.median(change)),
+                    "rises": int((change > 0).sum()), "resolved": int(done.sum())})
+    return out
+
+
+def markdown(results: list[dict]) -> str:
+    """The arms' resolution and :func:`by_kind` as markdown tables."""
+    n = len(results)
+    lines = ["| | resolved to the right answer | the truth's probability rises |",
+             "|---|---|---|"]
+    for arm in ARMS:
+        k = sum(r[arm]["resolved"] for r in results)
+        up = sum(r[arm]["p_true"] > r["p_true"] for r in results)
+        lines.append(f"| {arm} | {k} / {n} | {up} / {n} |")
+    lines += ["", "| kind of test (both arms) | run | mean expected gain (bits) | median change "
+              "of ln P(truth) | P(truth) rises | resolved |", "|---|---|---|---|---|---|"]
+    lines += [f"| {k['kind']} | {k['n']} | {k['gain_bits']:.2f} | {k['median_log_change']:+.2f} "
+              f"| {k['rises']} | {k['resolved']} |" for k in by_kind(results)]
+    return "\n".join(lines) + "\n"
+
+
 def run_campaign(folder: Path, out: Path, seed: int, boot: int) -> dict | None:
     """Both arms of one campaign; None when its report is not inconclusive."""
     truth = json.loads((folder.parent / "truth" / f"{folder.name}.json").read_text())
@@ -160,7 +211,8 @@ def run_campaign(folder: Path, out: Path, seed: int, boot: int) -> dict | None:
         document = write_followup(folder, out, truth, arm, test)
         diagnose(out / document["campaign"], boot)
         row = score_campaign(out / document["campaign"], document)
-        result[arm] = {"test": test["test"], "gain_bits": test["gain_bits"],
+        result[arm] = {"test": test["test"], "kind": kind_of(test),
+                       "gain_bits": test["gain_bits"],
                        "runs": document["followup"]["runs"], "verdict": row["verdict"],
                        "outcome": row["outcome"], "resolved": resolved(row, truth),
                        "p_leading": row["p_leading"], "leading": row["leading"],
@@ -171,13 +223,22 @@ def run_campaign(folder: Path, out: Path, seed: int, boot: int) -> dict | None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m testbeds.apart.followup",
                                      description=__doc__.split("\n\n")[0])
-    parser.add_argument("dir", type=Path, help="folder written by testbeds.apart.campaigns")
-    parser.add_argument("--out", type=Path, required=True, help="where the follow-ups go")
+    parser.add_argument("dir", type=Path, nargs="?",
+                        help="folder written by testbeds.apart.campaigns")
+    parser.add_argument("--out", type=Path, help="where the follow-ups go")
     parser.add_argument("--seed", type=int, default=0, help="seed of the random arm")
     parser.add_argument("--only", help="comma-separated campaigns (default: every one)")
     parser.add_argument("--boot", type=int, default=20, help="swtlab gap --boot")
     parser.add_argument("--json", type=Path, help="write the results here")
+    parser.add_argument("--summarise", type=Path, nargs="+", metavar="JSON",
+                        help="print the tables of results written by --json, and stop")
     args = parser.parse_args(argv)
+    if args.summarise:
+        print(markdown([r for f in args.summarise
+                        for r in json.loads(f.read_text())["campaigns"]]), end="")
+        return 0
+    if args.dir is None or args.out is None:
+        parser.error("DIR and --out are needed to run follow-ups")
     names = (args.only.split(",") if args.only else
              [p.stem for p in sorted((args.dir / "truth").glob("c*.json"))])
     if not names:
