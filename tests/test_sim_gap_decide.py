@@ -137,20 +137,35 @@ def test_priors_sum_to_one_and_split_a_set_over_its_laws():
     assert outside_prior(3) == pytest.approx(0.1 + 0.9 / 4)  # all three: one size of four
 
 
+def _braked_truth_points(law: str) -> pd.DataFrame:
+    truth = replace(BASE.with_soil(**TRUTH_SOIL), braked_law=law)
+    return synthetic_points(truth, loads=(80.0, 300.0), slips=(-0.4, -0.1, 0.1, 0.4),
+                            multipass=(0,))
+
+
+@pytest.fixture(scope="module")
+def driven_only():
+    """The driven runs (slip > 0) of :func:`_braked_truth_points` and their diagnosis, once:
+    a braked law changes braked runs only, so each law's driven runs are these (the test
+    checks it) and their diagnosis the same."""
+    points = _braked_truth_points(BRAKED_LAWS[0])
+    driven = points[points["slip"] > 0]
+    return driven, diagnose(driven, Simulated(BASE), ["bulldozing"], FAST)
+
+
 @pytest.mark.parametrize("law", BRAKED_LAWS)
-def test_the_base_model_takes_the_braked_branch_the_braked_runs_show(law):
+def test_the_base_model_takes_the_braked_branch_the_braked_runs_show(law, driven_only):
     """In family (the truth is this model under one braked law): with braked runs, the soil
     recalibrated under the truth's braked law has the larger evidence and every hypothesis
     is fitted under it; without braked runs nothing is chosen."""
-    truth = replace(BASE.with_soil(**TRUTH_SOIL), braked_law=law)
-    points = synthetic_points(truth, loads=(80.0, 300.0), slips=(-0.4, -0.1, 0.1, 0.4),
-                              multipass=(0,))
+    points = _braked_truth_points(law)
     report = diagnose(points, Simulated(BASE), ["bulldozing"], FAST)
     assert report["base_model"]["braked_law"] == law
     evidence = report["base_model"]["soil_only_log_evidence"]
     assert evidence[law] > max(v for k, v in evidence.items() if k != law) + 5.0
-    driven = points[points["slip"] > 0]
-    assert diagnose(driven, Simulated(BASE), ["bulldozing"], FAST)["base_model"] == {}
+    driven, driven_report = driven_only
+    pd.testing.assert_frame_equal(points[points["slip"] > 0], driven)
+    assert driven_report["base_model"] == {}
 
 
 def test_what_the_lab_declared_limits_the_hypotheses():
