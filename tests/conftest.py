@@ -274,27 +274,55 @@ def _sqlite_copy(source: Path, target: Path) -> None:
         a.backup(b)
 
 
-@pytest.fixture(scope="session")
-def processed_sample_db(tmp_path_factory) -> str:
-    """The committed sample campaign processed once into a SQLite database (URL); each
-    worker gets its own copy of it. The pytest-xdist workers of one run process it once
-    between them: the first to need it processes, the others wait on a lock, then copy it
-    (the folder above a worker's base temporary folder is that run's own)."""
+def _once_per_run(tmp_path_factory, name: str, make) -> Path:
+    """``name`` in the test run's shared folder, made by ``make(path)`` once per run: the
+    pytest-xdist workers of one run share it, the first to need it makes it while the others
+    wait on a lock (the folder above a worker's base temporary folder is that run's own).
+    What is shared is only read."""
     import fcntl
 
-    from swtlab_cli.main import main
-
-    mine = tmp_path_factory.mktemp("sample_db") / "swtlab.sqlite"
     base = tmp_path_factory.getbasetemp()
     shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
-    done = shared / "sample_campaign.sqlite"
-    with open(shared / "sample_campaign.lock", "w") as lock:
+    done = shared / name
+    with open(shared / f"{name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if done.exists():
-            _sqlite_copy(done, mine)
-        else:
-            campaign = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
-            assert main(["process", str(campaign), "--db", f"sqlite:///{mine}", "--quiet"]) == 0
-            _sqlite_copy(mine, shared / "sample_campaign.partial")
-            (shared / "sample_campaign.partial").rename(done)
+        if not done.exists():
+            partial = shared / f"{name}.partial"
+            make(partial)
+            partial.rename(done)
+    return done
+
+
+@pytest.fixture(scope="session")
+def processed_sample_db(tmp_path_factory) -> str:
+    """The committed sample campaign processed once per test run (:func:`_once_per_run`)
+    into a SQLite database (URL); each worker gets its own copy of it."""
+    from swtlab_cli.main import main
+
+    def make(path: Path) -> None:
+        made = tmp_path_factory.mktemp("sample_db_made") / "swtlab.sqlite"
+        campaign = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
+        assert main(["process", str(campaign), "--db", f"sqlite:///{made}", "--quiet"]) == 0
+        _sqlite_copy(made, path)
+
+    mine = tmp_path_factory.mktemp("sample_db") / "swtlab.sqlite"
+    _sqlite_copy(_once_per_run(tmp_path_factory, "sample_campaign.sqlite", make), mine)
     return f"sqlite:///{mine}"
+
+
+@pytest.fixture(scope="session")
+def varied_campaign(tmp_path_factory) -> Path:
+    """The virtual testbed's varied campaign (``varied_conditions``: 56 runs, seed 11, every
+    third run CSV, the others MCAP; truths in ``truth/``), generated once per test run
+    (:func:`_once_per_run`) for the modules that read it: tests/test_stable_phase_virtual.py,
+    tests/test_run_results_virtual.py. Read only."""
+    from virtual_testbed import generate_campaign
+    from virtual_testbed.sample_campaign import SAMPLE_RATES
+    from virtual_testbed.varied_campaign import varied_conditions
+
+    def make(path: Path) -> None:
+        conditions = varied_conditions()
+        forms = {c.run_id: ("csv" if i % 3 == 0 else "mcap") for i, c in enumerate(conditions)}
+        generate_campaign(path, conditions, seed=11, rates=SAMPLE_RATES, form=forms)
+
+    return _once_per_run(tmp_path_factory, "varied_campaign_11", make)

@@ -30,12 +30,10 @@ LAW_KEY = {"slip": "slip", "dp_n": "dp_n", "torque_nm": "torque_nm", "thrust_n":
 FORCES = ("wheel_load_n", "dp_n", "thrust_n", "resistance_n")
 
 
-def _campaign(out, seed: int, testbed: VirtualTestbed | None = None):
-    conditions = varied_conditions()
-    forms = {c.run_id: ("csv" if i % 3 == 0 else "mcap") for i, c in enumerate(conditions)}
-    generate_campaign(out, conditions, seed=seed, rates=RATES, form=forms, testbed=testbed)
+def _processed(out):
+    """(truth, run, result) per run of a ``varied_conditions`` campaign written to ``out``."""
     pairs = []
-    for c in conditions:
+    for c in varied_conditions():
         truth = json.loads((out / "truth" / f"{c.run_id}.json").read_text())
         run = ingest.read_run(out / truth["raw_file"])
         pairs.append((truth, run, process_run(run)))
@@ -43,17 +41,22 @@ def _campaign(out, seed: int, testbed: VirtualTestbed | None = None):
 
 
 @pytest.fixture(scope="module")
-def processed(tmp_path_factory):
-    """The default testbed: its load cells drift (random walk, ~0.5 N) after zeroing."""
-    return _campaign(tmp_path_factory.mktemp("results_drift"), seed=11)
+def processed(varied_campaign):
+    """The default testbed: its load cells drift (random walk, ~0.5 N) after zeroing
+    (conftest's campaign, shared with tests/test_stable_phase_virtual.py)."""
+    return _processed(varied_campaign)
 
 
 @pytest.fixture(scope="module")
 def processed_no_drift(tmp_path_factory):
     """Same design, load cells without drift: what the window statistics can see."""
     sensors = SensorModel(force_drift_n=0.0, torque_drift_nm=0.0)
-    return _campaign(tmp_path_factory.mktemp("results_no_drift"), seed=12,
-                     testbed=VirtualTestbed(sensors=sensors))
+    out = tmp_path_factory.mktemp("results_no_drift")
+    conditions = varied_conditions()
+    forms = {c.run_id: ("csv" if i % 3 == 0 else "mcap") for i, c in enumerate(conditions)}
+    generate_campaign(out, conditions, seed=12, rates=RATES, form=forms,
+                      testbed=VirtualTestbed(sensors=sensors))
+    return _processed(out)
 
 
 def _scale(key: str, truth: dict, value: float) -> float:

@@ -55,6 +55,16 @@ TRUTH_SOIL = {"kphi": 1.8e7 * 1.3, "friction_angle_deg": 35.5}
 CANDIDATES = ["grousers", "slip_sinkage", "bulldozing"]
 
 
+def _normal_pdf(cov: np.ndarray):
+    """The density of ``N(0, cov)`` at a residual, its inverse and determinant taken once:
+    ``stats.multivariate_normal(mean, cov).pdf`` checks and factors ``cov`` again at each of
+    the quadrature's thousands of points (7 CPU-s for the 50 integrals below, 0.3 s this way;
+    the integrals agree to 4e-13 relative)."""
+    precision = np.linalg.inv(cov)
+    log_norm = -0.5 * (np.linalg.slogdet(cov)[1] + len(cov) * np.log(2 * np.pi))
+    return lambda r: np.exp(log_norm - 0.5 * r @ precision @ r)
+
+
 def test_linearised_evidence_equals_the_integral_over_the_parameter():
     """A model linear in one parameter: the evidence is the integral of likelihood times
     prior over the parameter and the discrepancy grids (numerical quadrature)."""
@@ -69,12 +79,14 @@ def test_linearised_evidence_equals_the_integral_over_the_parameter():
     got = log_evidence(covariances(obs), y, a_hat * x, x[:, None], np.array([a_hat - mu]),
                        np.array([sd]))
 
-    def integrand(a, tau, nugget):
-        cov = np.diag(sigma ** 2 + (nugget * floor) ** 2) + tau ** 2 * kernel
-        return (stats.multivariate_normal(a * x, cov).pdf(y) * stats.norm(mu, sd).pdf(a))
+    prior = stats.norm(mu, sd)
 
-    z = np.mean([integrate.quad(integrand, -6, 8, args=(t, v))[0]
-                 for t in TAU_GRID for v in NUGGET_GRID])
+    def integrand(a, likelihood):
+        return likelihood(y - a * x) * prior.pdf(a)
+
+    z = np.mean([integrate.quad(integrand, -6, 8, args=(
+        _normal_pdf(np.diag(sigma ** 2 + (v * floor) ** 2) + t ** 2 * kernel),))[0]
+        for t in TAU_GRID for v in NUGGET_GRID])
     assert got.log_evidence == pytest.approx(np.log(z), abs=1e-6)
     assert got.tau_weights.sum() == pytest.approx(1.0)
 
@@ -96,12 +108,13 @@ def test_evidence_integrates_only_over_the_parameters_range():
                         np.array([sd]))
     prior_mass = stats.norm(mu, sd).cdf(hi) - stats.norm(mu, sd).cdf(lo)
 
-    def integrand(a, nugget):
-        cov = np.diag(sigma ** 2 + (nugget * floor) ** 2)
-        return (stats.multivariate_normal(a * x, cov).pdf(y) * stats.norm(mu, sd).pdf(a)
-                / prior_mass)
+    prior = stats.norm(mu, sd)
 
-    z = np.mean([integrate.quad(integrand, lo, hi, args=(v,))[0] for v in NUGGET_GRID])
+    def integrand(a, likelihood):
+        return likelihood(y - a * x) * prior.pdf(a) / prior_mass
+
+    z = np.mean([integrate.quad(integrand, lo, hi, args=(
+        _normal_pdf(np.diag(sigma ** 2 + (v * floor) ** 2)),))[0] for v in NUGGET_GRID])
     assert bounded.log_evidence == pytest.approx(np.log(z), abs=1e-6)
     assert free.log_evidence - bounded.log_evidence > 2.0
 
@@ -124,20 +137,35 @@ def test_priors_sum_to_one_and_split_a_set_over_its_laws():
     assert outside_prior(3) == pytest.approx(0.1 + 0.9 / 4)  # all three: one size of four
 
 
+def _braked_truth_points(law: str) -> pd.DataFrame:
+    truth = replace(BASE.with_soil(**TRUTH_SOIL), braked_law=law)
+    return synthetic_points(truth, loads=(80.0, 300.0), slips=(-0.4, -0.1, 0.1, 0.4),
+                            multipass=(0,))
+
+
+@pytest.fixture(scope="module")
+def driven_only():
+    """The driven runs (slip > 0) of :func:`_braked_truth_points` and their diagnosis, once:
+    a braked law changes braked runs only, so each law's driven runs are these (the test
+    checks it) and their diagnosis the same."""
+    points = _braked_truth_points(BRAKED_LAWS[0])
+    driven = points[points["slip"] > 0]
+    return driven, diagnose(driven, Simulated(BASE), ["bulldozing"], FAST)
+
+
 @pytest.mark.parametrize("law", BRAKED_LAWS)
-def test_the_base_model_takes_the_braked_branch_the_braked_runs_show(law):
+def test_the_base_model_takes_the_braked_branch_the_braked_runs_show(law, driven_only):
     """In family (the truth is this model under one braked law): with braked runs, the soil
     recalibrated under the truth's braked law has the larger evidence and every hypothesis
     is fitted under it; without braked runs nothing is chosen."""
-    truth = replace(BASE.with_soil(**TRUTH_SOIL), braked_law=law)
-    points = synthetic_points(truth, loads=(80.0, 300.0), slips=(-0.4, -0.1, 0.1, 0.4),
-                              multipass=(0,))
+    points = _braked_truth_points(law)
     report = diagnose(points, Simulated(BASE), ["bulldozing"], FAST)
     assert report["base_model"]["braked_law"] == law
     evidence = report["base_model"]["soil_only_log_evidence"]
     assert evidence[law] > max(v for k, v in evidence.items() if k != law) + 5.0
-    driven = points[points["slip"] > 0]
-    assert diagnose(driven, Simulated(BASE), ["bulldozing"], FAST)["base_model"] == {}
+    driven, driven_report = driven_only
+    pd.testing.assert_frame_equal(points[points["slip"] > 0], driven)
+    assert driven_report["base_model"] == {}
 
 
 def test_what_the_lab_declared_limits_the_hypotheses():

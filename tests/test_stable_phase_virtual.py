@@ -13,25 +13,19 @@ import pytest
 
 import ingest
 from stable_phase import DETECTORS, StablePhaseParams, detect_stable_phase
-from virtual_testbed import generate_campaign
-from virtual_testbed.sample_campaign import SAMPLE_RATES
 from virtual_testbed.varied_campaign import varied_conditions
 
-RATES = SAMPLE_RATES
 START_TOLERANCE_S = 2.0
 
 
 @pytest.fixture(scope="module")
-def detected(tmp_path_factory):
-    """(truth, window) per run of a 56-run campaign in both forms (every third run CSV)."""
-    out = tmp_path_factory.mktemp("stable_phase_campaign")
-    conditions = varied_conditions()
-    forms = {c.run_id: ("csv" if i % 3 == 0 else "mcap") for i, c in enumerate(conditions)}
-    generate_campaign(out, conditions, seed=11, rates=RATES, form=forms)
+def detected(varied_campaign):
+    """(truth, window) per run of a 56-run campaign in both forms (every third run CSV;
+    conftest's, shared with tests/test_run_results_virtual.py)."""
     pairs = []
-    for c in conditions:
-        truth = json.loads((out / "truth" / f"{c.run_id}.json").read_text())
-        run = ingest.read_run(out / truth["raw_file"])
+    for c in varied_conditions():
+        truth = json.loads((varied_campaign / "truth" / f"{c.run_id}.json").read_text())
+        run = ingest.read_run(varied_campaign / truth["raw_file"])
         pairs.append((truth, run, detect_stable_phase(run)))
     return pairs
 
