@@ -260,7 +260,10 @@ def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covaria
     run_grid = RUN_SOIL_GRID if obs.kernel_run is not None else np.zeros(1)
     sizes = np.array(list(itertools.product(TAU_GRID, outside, NUGGET_GRID, run_grid)))
     terms = CovarianceTerms.of(obs)
-    lower = np.array([cholesky(terms.at(s), lower=True, check_finite=False) for s in sizes])
+    # each factor column-major, as LAPACK reads it: grid_log_evidence's triangular solves
+    # would copy a row-major one at every call
+    lower = np.array([cholesky(terms.at(s), lower=True, check_finite=False).T
+                      for s in sizes]).transpose(0, 2, 1)
     log_det = 2.0 * np.sum(np.log(np.diagonal(lower, axis1=1, axis2=2)), axis=1)
     return Covariances(lower, log_det,
                        (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)), sizes)
