@@ -17,7 +17,7 @@ from threadpoolctl import threadpool_limits
 from terramechanics.model import BRAKED_LAWS
 from sim_gap import candidates as cands
 from sim_gap.bagging import N_BAGS, BagModel, bagged_posterior
-from sim_gap.crossval import contrasts, cross_validate, folds
+from sim_gap.crossval import contrasts, folds, held_out
 from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate
 from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances,
                               held_out_dispersion, level_groups, log_evidence,
@@ -443,11 +443,10 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
         decision["next_tests"] = decision["admissible_tests"][:TOP_TESTS]
     elif decision["verdict"] == OUTSIDE:
         decision["separating_test"] = largest_gap(regions)
-    before = cross_validate(sim, fits["soil_only"].fit.candidate, points, sig, None,
-                            settings.max_nfev, settings.fold_nfev)
+    before = held_out(sim, fits["soil_only"].fit.candidate, points, sig, None,
+                      settings.fold_nfev)
     after = (before if chosen.candidate.key == "soil_only" else
-             cross_validate(sim, chosen.candidate, points, sig, None, settings.max_nfev,
-                            settings.fold_nfev))
+             held_out(sim, chosen.candidate, points, sig, None, settings.fold_nfev))
     predictions = {"simulation": sim.predict(points, {}), "soil_only": sim.predict(
         points, soil_values), decision["chosen"]: sim.predict(points, chosen.values)}
     return {
