@@ -43,12 +43,16 @@ def contrasts(points: pd.DataFrame) -> dict[str, int]:
     return {label: int(points[column].round(6).nunique()) for column, label in FACTORS}
 
 
+#: one fold's name, held-out mask, held-out standardised residuals and fitted values
+Fold = tuple[str, np.ndarray, np.ndarray, dict[str, float]]
+
+
 @dataclass(frozen=True)
 class CrossValidated:
     """The full-data fit and, per fold, the held-out standardised residuals."""
 
     full: FitResult
-    held_out: list[tuple[str, np.ndarray, np.ndarray, dict[str, float]]]  # name, mask, r, values
+    held_out: list[Fold]
 
     def run_losses(self, n_points: int) -> np.ndarray:
         """Per point (run): mean held-out squared standardised residual over its folds and
@@ -60,20 +64,28 @@ class CrossValidated:
             count[mask] += np.isfinite(r).sum(axis=1)
         return total / np.maximum(count, 1)
 
-    def held_out_predictions(self, sim: Simulated, points: pd.DataFrame
-                             ) -> list[tuple[np.ndarray, dict[str, np.ndarray]]]:
-        """Per fold: held-out mask and the fold fit's predictions there."""
-        return [(mask, sim.predict(points[mask].reset_index(drop=True), values))
-                for _, mask, _, values in self.held_out]
+
+def held_out_predictions(sim: Simulated, points: pd.DataFrame, held: list[Fold]
+                         ) -> list[tuple[np.ndarray, dict[str, np.ndarray]]]:
+    """Per fold: held-out mask and the fold fit's predictions there."""
+    return [(mask, sim.predict(points[mask].reset_index(drop=True), values))
+            for _, mask, _, values in held]
 
 
 def cross_validate(sim: Simulated, c: Candidate, points: pd.DataFrame,
                    sigma: dict[str, np.ndarray], start: dict[str, float] | None = None,
                    max_nfev: int = 40, fold_nfev: int = 15) -> CrossValidated:
-    """Fit on all points, then refit on each fold's training points from the same ``start``
-    as the full fit (never from the full fit, which has seen the held-out points) and keep
-    the standardised residuals of the held-out points."""
-    full = fit_candidate(sim, c, points, sigma, start, max_nfev)
+    """Fit on all points, then each fold (:func:`held_out`)."""
+    return CrossValidated(fit_candidate(sim, c, points, sigma, start, max_nfev),
+                          held_out(sim, c, points, sigma, start, fold_nfev))
+
+
+def held_out(sim: Simulated, c: Candidate, points: pd.DataFrame,
+             sigma: dict[str, np.ndarray], start: dict[str, float] | None = None,
+             fold_nfev: int = 15) -> list[Fold]:
+    """Refit on each fold's training points from ``start`` (never from a full fit, which
+    has seen the held-out points) and keep the standardised residuals of the held-out
+    points."""
     held = []
     for name, mask in folds(points):
         train = _subset(points, ~mask)
@@ -83,7 +95,7 @@ def cross_validate(sim: Simulated, c: Candidate, points: pd.DataFrame,
         r = standardised_residuals(test, sim.predict(test, fit.values),
                                    {q: s[mask] for q, s in sigma.items()})
         held.append((name, mask, r, fit.values))
-    return CrossValidated(full, held)
+    return held
 
 
 def _subset(points: pd.DataFrame, mask: np.ndarray) -> pd.DataFrame:

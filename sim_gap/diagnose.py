@@ -17,7 +17,7 @@ from threadpoolctl import threadpool_limits
 from terramechanics.model import BRAKED_LAWS
 from sim_gap import candidates as cands
 from sim_gap.bagging import N_BAGS, BagModel, bagged_posterior
-from sim_gap.crossval import contrasts, cross_validate, folds
+from sim_gap.crossval import contrasts, folds, held_out
 from sim_gap.decide import by_effect, by_effect_set, decide, learning_rate
 from sim_gap.evidence import (TAU_GRID, Evidence, apart_by, covariances,
                               held_out_dispersion, level_groups, log_evidence,
@@ -121,26 +121,29 @@ def _evidence(cov, obs, sim: Simulated, f: MapFit) -> Evidence:
 
 
 def _braked_law(sim: Simulated, points: pd.DataFrame, obs, fit_sig, settings: Settings
-                ) -> tuple[Simulated, dict]:
+                ) -> tuple[Simulated, dict, dict[str, MapFit]]:
     """``sim`` with the base model's braked branch (:data:`terramechanics.model.BRAKED_LAWS`)
     whose soil-only recalibration has the larger evidence, where the points have braked or
     towed runs (slip < 0), and the log evidence of each (empty without such runs). The two
     published treatments of a braked wheel (Wong & Reece 1967 part II; part I at the signed
     slip, Ishigami et al. 2007) are two forms of the base model with equal prior weight: the
     choice is made once, by the evidence of soil recalibration alone (type II), before any
-    effect is fitted, so no effect can pick the branch that suits it."""
+    effect is fitted, so no effect can pick the branch that suits it. Also returns the
+    chosen branch's soil-only fit under its key (the first of the singles, not fitted
+    twice), none without braked runs."""
     if not (points["slip"].to_numpy(float) < 0).any():
-        return sim, {}
-    trials, scores = {}, {}
+        return sim, {}, {}
+    trials, scores, soils = {}, {}, {}
     for law in BRAKED_LAWS:
         trial = replace(sim, model=replace(sim.model, braked_law=law), _base_cache={})
         soil = _fit_all(trial, [cands.candidate(trial.model, ())], points, fit_sig,
                         settings)["soil_only"]
         obs_law = run_soil(obs, soil.jac, param_prior(soil.fit.candidate, trial.model)[1])
-        trials[law] = trial
+        trials[law], soils[law] = trial, soil
         scores[law] = _evidence(covariances(obs_law), obs_law, trial, soil).log_evidence
     best = max(scores, key=scores.__getitem__)
-    return trials[best], {"braked_law": best, "soil_only_log_evidence": scores}
+    return (trials[best], {"braked_law": best, "soil_only_log_evidence": scores},
+            {"soil_only": soils[best]})
 
 
 def _reference_laws(fits: dict[str, MapFit], evidence: dict[str, Evidence]) -> dict[str, str]:
@@ -389,9 +392,10 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
     sig = sigmas(points, sim.radius_m)
     obs = observations(points, sig, sim.radius_m)
     fit_sig = _fit_noise(points, sig, sim.radius_m)
-    sim, base_model = _braked_law(sim, points, obs, fit_sig, settings)
+    sim, base_model, fits = _braked_law(sim, points, obs, fit_sig, settings)
     single_list = cands.singles(sim.model, allowed)
-    fits = _fit_all(sim, single_list, points, fit_sig, settings)
+    fits.update(_fit_all(sim, [c for c in single_list if c.key not in fits], points, fit_sig,
+                         settings))
     obs = run_soil(obs, fits["soil_only"].jac,
                    param_prior(fits["soil_only"].fit.candidate, sim.model)[1])
     cov = covariances(obs)
@@ -443,11 +447,10 @@ def _diagnose(points: pd.DataFrame, sim: Simulated, effects: list[str] | None,
         decision["next_tests"] = decision["admissible_tests"][:TOP_TESTS]
     elif decision["verdict"] == OUTSIDE:
         decision["separating_test"] = largest_gap(regions)
-    before = cross_validate(sim, fits["soil_only"].fit.candidate, points, sig, None,
-                            settings.max_nfev, settings.fold_nfev)
+    before = held_out(sim, fits["soil_only"].fit.candidate, points, sig, None,
+                      settings.fold_nfev)
     after = (before if chosen.candidate.key == "soil_only" else
-             cross_validate(sim, chosen.candidate, points, sig, None, settings.max_nfev,
-                            settings.fold_nfev))
+             held_out(sim, chosen.candidate, points, sig, None, settings.fold_nfev))
     predictions = {"simulation": sim.predict(points, {}), "soil_only": sim.predict(
         points, soil_values), decision["chosen"]: sim.predict(points, chosen.values)}
     return {

@@ -260,7 +260,10 @@ def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covaria
     run_grid = RUN_SOIL_GRID if obs.kernel_run is not None else np.zeros(1)
     sizes = np.array(list(itertools.product(TAU_GRID, outside, NUGGET_GRID, run_grid)))
     terms = CovarianceTerms.of(obs)
-    lower = np.array([cholesky(terms.at(s), lower=True, check_finite=False) for s in sizes])
+    # each factor column-major, as LAPACK reads it: grid_log_evidence's triangular solves
+    # would copy a row-major one at every call
+    lower = np.array([cholesky(terms.at(s), lower=True, check_finite=False).T
+                      for s in sizes]).transpose(0, 2, 1)
     log_det = 2.0 * np.sum(np.log(np.diagonal(lower, axis1=1, axis2=2)), axis=1)
     return Covariances(lower, log_det,
                        (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)), sizes)
@@ -353,8 +356,15 @@ def grid_log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, ja
     if bounds_from_prior is not None:
         lo, hi = bounds_from_prior
         prior_in_box = np.sum(_log_interval(lo / prior_sd, hi / prior_sd))
-    logs = np.empty(cov.log_det.size)
+    # what every grid point shares is computed once, and the box probabilities of all grid
+    # points in one call: the loop runs thousands of times per diagnosis on small matrices
+    n_grid, n_params = cov.log_det.size, jac.shape[1]
+    logs = np.empty(n_grid)
+    mean, sd = np.empty((n_grid, n_params)), np.empty((n_grid, n_params))
     prior_precision = np.diag(1.0 / prior_var)
+    log_prior_det = np.sum(np.log(prior_var))
+    gauss_norm = 0.5 * residual.size * np.log(2.0 * np.pi)
+    identity = np.eye(n_params)
     for g, (factor, log_det) in enumerate(zip(cov.lower, cov.log_det)):
         x = _lapack(dtrtrs, factor, rhs, lower=1)
         xr, xj = x[:, 0], x[:, 1:]
@@ -362,12 +372,13 @@ def grid_log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, ja
         m_factor = _lapack(dpotrf, prior_precision + xj.T @ xj, lower=1, clean=1)
         w = _lapack(dtrtrs, m_factor, b, lower=1)
         logs[g] = (-0.5 * (xr @ xr - w @ w) - 0.5 * log_det
-                   - 0.5 * (np.sum(np.log(prior_var)) + 2.0 * np.sum(np.log(np.diagonal(
-                       m_factor)))) - 0.5 * residual.size * np.log(2.0 * np.pi))
+                   - 0.5 * (log_prior_det + 2.0 * np.sum(np.log(np.diagonal(m_factor))))
+                   - gauss_norm)
         if bounds_from_prior is not None:
-            post_cov = _lapack(dpotrs, m_factor, np.eye(b.size), lower=1)
-            mean, sd = post_cov @ b, np.sqrt(np.diagonal(post_cov))
-            logs[g] += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd)) - prior_in_box
+            post_cov = _lapack(dpotrs, m_factor, identity, lower=1)
+            mean[g], sd[g] = post_cov @ b, np.sqrt(np.diagonal(post_cov))
+    if bounds_from_prior is not None:
+        logs += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd), axis=1) - prior_in_box
     return logs
 
 

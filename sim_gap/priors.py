@@ -12,6 +12,7 @@ soils from pinning a parameter.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -63,7 +64,18 @@ def soil_prior(width_m: float, soils: pd.DataFrame | None = None) -> tuple[Param
     ``soil.cohesion_pa``, ``soil.friction_angle_deg``, ``soil.shear_modulus_m``."""
     if width_m <= 0:
         raise ValueError(f"width_m must be > 0, got {width_m}")
-    soils = published_soils() if soils is None else soils
+    return _published_prior(width_m) if soils is None else _prior(width_m, soils)
+
+
+@lru_cache(maxsize=None)
+def _published_prior(width_m: float) -> tuple[ParamPrior, ...]:
+    """:func:`soil_prior` of the published soils, read and computed once per width: a
+    diagnosis asks for it at every candidate's evidence (hundreds of times), and the table
+    is a file of the package."""
+    return _prior(width_m, published_soils())
+
+
+def _prior(width_m: float, soils: pd.DataFrame) -> tuple[ParamPrior, ...]:
     columns = {"soil.kphi": soils["kc"] / width_m + soils["kphi"], "soil.n": soils["n"],
                "soil.cohesion_pa": soils["cohesion_pa"],
                "soil.friction_angle_deg": soils["friction_angle_deg"],

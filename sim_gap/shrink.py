@@ -7,19 +7,19 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from sim_gap.crossval import CrossValidated
+from sim_gap.crossval import Fold, held_out_predictions
 from sim_gap.fit import quantities_of
 from sim_gap.simulated import Simulated
 from sim_gap.vocabulary import slip_band, slip_band_labels
 
 
-def _squared_sums(sim: Simulated, points: pd.DataFrame, cv: CrossValidated
+def _squared_sums(sim: Simulated, points: pd.DataFrame, held: list[Fold]
                   ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Per quantity: per point, the sum of squared held-out residuals over its folds and
     their count."""
     n = len(points)
     out = {q: (np.zeros(n), np.zeros(n)) for q in quantities_of(points)}
-    for mask, pred in cv.held_out_predictions(sim, points):
+    for mask, pred in held_out_predictions(sim, points, held):
         for q in out:
             r = points[q].to_numpy(float)[mask] - pred[q]
             if q == "sinkage_m" and points.attrs.get("sinkage_relative"):
@@ -35,7 +35,7 @@ def _rmse(weights: np.ndarray, sums: np.ndarray, counts: np.ndarray) -> np.ndarr
     return np.sqrt((weights @ sums) / np.maximum(weights @ counts, 1e-300))
 
 
-def shrink(sim: Simulated, points: pd.DataFrame, before: CrossValidated, after: CrossValidated,
+def shrink(sim: Simulated, points: pd.DataFrame, before: list[Fold], after: list[Fold],
            n_boot: int = 200, seed: int = 0) -> dict:
     """``held_out_rmse_before``/``_after`` and ``shrink_pct`` per quantity (with 95 %
     bootstrap intervals) and the same per slip band."""

@@ -58,21 +58,32 @@ class Simulated:
         on = set() if self.external else set(self.model.effects)
         return [name for name in tm.EFFECTS if name not in on]
 
-    def _model_curves(self, model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
+    def _wheel_groups(self, points: pd.DataFrame) -> list[tuple[dict, np.ndarray | None,
+                                                                 tuple[np.ndarray, ...]]]:
+        """Per wheel the points are simulated with: its fields for ``WheelModel.with_wheel``
+        (none: the model's own), its rows (None: all) and their conditions."""
+        conditions = _conditions(points)
         if not self.wheel_per_row:
-            return self._curves_at(model, points)
-        out = {q: np.full(len(points), np.nan) for q in QUANTITIES}
+            return [({}, None, conditions)]
+        groups = []
         for key, idx in points.groupby(list(WHEEL_KEY), sort=False).indices.items():
             wheel = dict(zip(("radius_m", "width_m", "grouser_count", "grouser_height_m"), key))
             wheel["grouser_count"] = int(wheel["grouser_count"])
-            part = self._curves_at(model.with_wheel(**wheel), points.iloc[idx])
+            groups.append((wheel, idx, tuple(c[idx] for c in conditions)))
+        return groups
+
+    @staticmethod
+    def _model_curves(model: tm.WheelModel, groups: list, n_points: int
+                      ) -> dict[str, np.ndarray]:
+        """``model`` at the points of ``groups`` (:meth:`_wheel_groups`), ``n_points`` of them."""
+        if groups[0][1] is None:
+            return Simulated._curves_of(model, groups[0][2])
+        out = {q: np.full(n_points, np.nan) for q in QUANTITIES}
+        for wheel, idx, conditions in groups:
+            part = Simulated._curves_of(model.with_wheel(**wheel), conditions)
             for q in QUANTITIES:
                 out[q][idx] = part[q]
         return out
-
-    @staticmethod
-    def _curves_at(model: tm.WheelModel, points: pd.DataFrame) -> dict[str, np.ndarray]:
-        return Simulated._curves_of(model, _conditions(points))
 
     @staticmethod
     def _curves_of(model: tm.WheelModel, conditions: tuple[np.ndarray, ...]
@@ -92,12 +103,12 @@ class Simulated:
                     out[q][idx] = v
         return out
 
-    def _base(self, points: pd.DataFrame) -> tuple[dict, dict]:
+    def _base(self, points: pd.DataFrame, groups: list) -> tuple[dict, dict]:
         cols = ["wheel_load_n", "slip", "multipass", "gravity_mps2"]
         key = points[cols + [c for c in WHEEL_KEY if c in points]].to_numpy(float).tobytes()
         if key not in self._base_cache:
             self._base_cache.clear()
-            model0 = self._model_curves(self.model, points)
+            model0 = self._model_curves(self.model, groups, len(points))
             sim0 = (self._wpm_curves(points) if self.wpm is not None else
                     at_points(self.table, points, self.source) if self.table is not None
                     else model0)
@@ -108,23 +119,28 @@ class Simulated:
                 ) -> dict[str, np.ndarray]:
         """Each quantity at every point with the dotted-name ``values`` changed (naming
         ``effects.<name>.<param>`` switches that effect on)."""
-        values = values or {}
-        if not self.external:
-            return self._model_curves(self.model.with_parameters(values), points)
-        model0, sim0 = self._base(points)
-        if not values:
-            return dict(sim0)
-        changed = self._model_curves(self.model.with_parameters(values), points)
-        return {q: sim0[q] + changed[q] - model0[q] for q in QUANTITIES}
+        return self.predictor(points)(values or {})
 
     def predictor(self, points: pd.DataFrame) -> Callable[[dict], dict[str, np.ndarray]]:
-        """:meth:`predict` at fixed ``points``, their conditions read once where the model
-        is the simulation (a fit calls it hundreds of times)."""
-        if self.external or self.wheel_per_row:
-            return lambda values: self.predict(points, values)
-        conditions = _conditions(points)
-        return lambda values: self._curves_of(self.model.with_parameters(values or {}),
-                                              conditions)
+        """:meth:`predict` at fixed ``points``, their conditions and wheels read once: a fit
+        calls it hundreds of times, and each column read from the points costs pandas a deep
+        copy of their ``attrs`` (the sources' wheels)."""
+        groups, n = self._wheel_groups(points), len(points)
+
+        def model_at(values: dict) -> dict[str, np.ndarray]:
+            return self._model_curves(self.model.with_parameters(values), groups, n)
+
+        if not self.external:
+            return lambda values: model_at(values or {})
+        model0, sim0 = self._base(points, groups)
+
+        def corrected(values: dict) -> dict[str, np.ndarray]:
+            if not values:
+                return dict(sim0)
+            changed = model_at(values)
+            return {q: sim0[q] + changed[q] - model0[q] for q in QUANTITIES}
+
+        return corrected
 
 
 def _conditions(points: pd.DataFrame) -> tuple[np.ndarray, ...]:
