@@ -44,6 +44,13 @@ def select_model(samples: dict, radius_px: float, height_px: float, count: int,
     """
     nb = int(samples["bin"].max()) + 1
     pitch = 2 * np.pi / count
+    components = []  # what the 192 parameter sets share: (where, -rate, y, bin, sum of y^2)
+    for comp, key in (("r", "v_r"), ("t", "v_t")):
+        rate = rates_per_m[comp][samples["bin"]]
+        ok = np.isfinite(rate)
+        y, b = samples[key][ok], samples["bin"][ok]
+        components.append((ok, -rate[ok], y, b, np.bincount(b, y * y, nb)))
+    n = sum(int(ok.sum()) for ok, *_ in components)
     scores, theta1s, best_gamma = {}, {}, None
     for model in MODELS:
         best = (np.inf, 0.0, None)
@@ -52,19 +59,13 @@ def select_model(samples: dict, radius_px: float, height_px: float, count: int,
                 r_e = effective_radius(samples["theta"], samples["wheel_angle"], radius_px,
                                        height_px, count, model, theta1, gamma or 3.0)
                 rho = (samples["r_px"] - r_e) / px_per_m
-                sse, n = 0.0, 0
-                for comp, key in (("r", "v_r"), ("t", "v_t")):
-                    rate = rates_per_m[comp][samples["bin"]]
-                    ok = np.isfinite(rate)
-                    e = np.exp(-rate[ok] * rho[ok])
-                    y = samples[key][ok]
-                    b = samples["bin"][ok]
+                sse = 0.0
+                for ok, minus_rate, y, b, syy in components:
+                    e = np.exp(minus_rate * rho[ok])
                     sye = np.bincount(b, y * e, nb)
                     see = np.bincount(b, e * e, nb)
-                    syy = np.bincount(b, y * y, nb)
                     explained = np.where(see > 0, sye ** 2 / np.maximum(see, 1e-300), 0)
                     sse += float(np.sum(syy - explained))
-                    n += int(ok.sum())
                 rms = np.sqrt(sse / max(n, 1))
                 if rms < best[0]:
                     best = (rms, float(theta1), gamma)

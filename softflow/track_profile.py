@@ -41,7 +41,7 @@ class Strip:
         """Samples minus their row mean, zero outside the image."""
         n = np.maximum(self.counts, 1).astype(np.float32)
         x = np.where(self.valid, self.samples, np.float32(0))
-        return x - (x.sum(axis=1) / n)[:, None] * self.valid
+        return np.subtract(x, (x.sum(axis=1) / n)[:, None], out=x, where=self.valid)
 
 
 def direction_candidates(gray: np.ndarray, min_period_px: float, max_period_px: float,
@@ -128,7 +128,7 @@ def find_band(strip: Strip, freq_per_sample: float, min_len: float) -> tuple[int
         lo = np.arange(start, min(start + BAND_BLOCK_ROWS, z.size))[:, None]
         hi = np.arange(start + 3, z.size + 1)[None, :]
         snr = np.abs(total[hi] - total[lo]) / np.sqrt(np.maximum(count[hi] - count[lo], 1))
-        snr[hi - lo < 3] = 0.0
+        snr[:, :lo.size] = np.triu(snr[:, :lo.size])  # hi - lo < 3 below that diagonal
         row, col = divmod(int(np.argmax(snr)), snr.shape[1])
         if snr[row, col] > best:  # the first of equal maxima, as one argmax over all bands
             best, lo_best, hi_best = float(snr[row, col]), start + row, start + 3 + col

@@ -8,7 +8,7 @@ from scipy import ndimage
 
 from softflow.field_analysis import fit_profiles, jackknife_ci
 from softflow.flow_result import MeanField
-from softflow.polar import beta_bins, polar_coordinates, profiles
+from softflow.polar import beta_bins, group_value_order, polar_coordinates, profiles
 
 PX_PER_M, RIM_PX, K_PER_M, A3_PER_M = 1000.0, 40.0, 50.0, 65.0
 SLED = np.array([0.04, 0.0])
@@ -59,3 +59,13 @@ def test_jackknife_ci_holds_the_rates():
     assert len(cover_jk) >= 40
     assert np.mean(cover_jk) >= 0.9, np.mean(cover_jk)
     assert np.mean(cover_fit) < np.mean(cover_jk)  # the fit's own CI misses correlated noise
+
+
+def test_group_value_order_is_lexsort():
+    """profiles' sort by (group, value, position): lexsort's permutation, ties and -0.0 too."""
+    rng = np.random.default_rng(0)
+    for n in (0, 1, 2, 3, 5000):
+        groups = rng.integers(0, 40, n)
+        values = np.round(rng.normal(size=n), 1)  # many ties
+        values[np.flatnonzero(values == 0)[::2]] = -0.0  # beside +0.0
+        assert np.array_equal(group_value_order(values, groups), np.lexsort((values, groups)))

@@ -60,12 +60,12 @@ def test_sled_velocity_within_1_percent_and_reasons_per_angle(sky_run):
     assert all("not defined" in row["k_reason"] for row in under)  # v_r = 0 under the axle
 
 
-@pytest.mark.slow_render  # three frames rendered again, written and measured by swtlab flow
+@pytest.mark.slow_render  # the sky run's first three frames written and measured by swtlab flow
 def test_cli_fails_on_an_implausible_sled_velocity(sky_run, tmp_path, capsys):
     """The frames say the soil moves towards the image right while the metadata say the wheel
     travels to the left: the far soil would move with the sled. Exit 3, no JSON."""
-    scene = SecondScene(background="sky", slip=0.4, seed=25)
-    write_second(scene, tmp_path / "run", n_frames=3)
+    scene, (frames, t_s, truth) = sky_run
+    write_second(scene, (frames[:3], t_s[:3], truth), tmp_path / "run")
     record = json.loads((tmp_path / "run" / "run.json").read_text())
     record["camera"]["travel_direction"] = "-x"
     (tmp_path / "run" / "run.json").write_text(json.dumps(record))

@@ -275,12 +275,14 @@ def scene_truth(scene: SecondScene) -> dict:
             "tangential_decay_per_m": tangential_rate_per_m(scene, theta).tolist()}
 
 
-def write_second(scene: SecondScene, folder: str | Path, n_frames: int = 6) -> Path:
-    """``camera_side/<t_ns>.png`` (the JPEG-damaged frames, stored losslessly) and a
-    ``run.json`` (scale, direction, no wheel hints); the truth to ``second_flow_truth.json``."""
+def write_second(scene: SecondScene, rendered: tuple[list[np.ndarray], np.ndarray, dict],
+                 folder: str | Path) -> Path:
+    """Frames, times and truth of :func:`render_second` written as ``camera_side/<t_ns>.png``
+    (the JPEG-damaged frames, stored losslessly) and a ``run.json`` (scale, direction, no wheel
+    hints); the truth to ``second_flow_truth.json``."""
+    frames, times, truth = rendered
     folder = Path(folder)
     (folder / "camera_side").mkdir(parents=True, exist_ok=True)
-    frames, times, truth = render_second(scene, n_frames)
     for img, t_s in zip(frames, times):
         cv2.imwrite(str(folder / "camera_side" / f"{int(round(t_s * 1e9))}.png"), img)
     run = {"camera": {"px_per_m": scene.px_per_m,

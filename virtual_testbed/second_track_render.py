@@ -96,9 +96,14 @@ def render_second_track(scene: SecondTrackScene) -> tuple[np.ndarray, dict]:
     u0, v0 = u.min() - 0.01, v.min() - 0.01
     cw, ch = int((u.max() + 0.01 - u0) * res) + 2, int((v.max() + 0.01 - v0) * res) + 2
     canvas = np.full((ch, cw), 0.5, np.float32)
+    # some 100 000 speckles, each from its own draws in turn: rng.uniform(lo, hi) is lo + (hi - lo)
+    # * rng.random() and rng.normal(m, s) is m + s * rng.standard_normal() (the same numbers),
+    # and a scalar rng.random() takes 0.8 us where rng.uniform's argument checks take 2.7 us:
+    # this loop was most of the render
+    random, standard_normal, circle = rng.random, rng.standard_normal, cv2.circle
     for _ in range(int(0.02 * cw * ch)):
-        cv2.circle(canvas, (int(rng.uniform(0, cw)), int(rng.uniform(0, ch))),
-                   int(np.exp(rng.normal(0.7, 0.5))), float(rng.uniform(0.2, 0.8)), -1)
+        circle(canvas, (int(cw * random()), int(ch * random())),
+               int(np.exp(0.7 + 0.5 * standard_normal())), 0.2 + (0.8 - 0.2) * random(), -1)
     canvas = cv2.GaussianBlur(canvas, (0, 0), 1.0)
     sand = ndimage.map_coordinates(canvas, [(v - v0) * res, (u - u0) * res], order=1)
     across = np.clip((scene.track_width_m / 2 - np.abs(v)) / 0.004, 0, 1)  # inside the track

@@ -134,14 +134,28 @@ def _along_profile(slip, radius_m, grouser_count, grouser_height_m, nz, half_len
     smeared = (rng.uniform(size=k.size) < nz.smeared_fraction).astype(float)
     mean = uniform_filter1d(depth, int(round(spacing_m / _STEP_M)), mode="nearest")
     depth = mean + np.interp(grid_m, centres_m, scale) * (depth - mean)
-    blend = np.interp(grid_m, centres_m, smeared)
-    depth = (1 - blend) * depth + blend * gaussian_filter1d(depth, 0.15 * spacing_m / _STEP_M)
+    depth = _smear(depth, np.interp(grid_m, centres_m, smeared), 0.15 * spacing_m / _STEP_M)
     doubled = centres_m[rng.uniform(size=k.size) < nz.doubled_fraction] if nz.marks else []
     relief_m = np.ptp(depth)
     for c_m in doubled:  # a narrow re-bite 0.25-0.45 pitch later, 30-70 % of the relief deep
         x = (grid_m - c_m - rng.uniform(0.25, 0.45) * spacing_m) / nz.grouser_thickness_m
         depth += rng.uniform(0.3, 0.7) * relief_m * np.exp(-x * x)
     return grid_m, _collapse(-depth, nz.repose_deg), centres_m, spacing_m
+
+
+def _smear(depth: np.ndarray, blend: np.ndarray, sigma: float) -> np.ndarray:
+    """``(1 - blend) * depth + blend * gaussian_filter1d(depth, sigma)``, the filter taken only
+    over the runs where ``blend > 0``, each with the filter's reach (4 sigma) either side: the
+    same numbers, with the work in proportion to the smeared stretch (the profile holds some
+    100 000 samples, the kernel 1 000-4 000; most marks are not smeared)."""
+    reach = int(4 * sigma) + 1
+    out = depth.copy()
+    edges = np.flatnonzero(np.diff(np.r_[0, blend > 0, 0]))
+    for start, stop in zip(edges[::2], edges[1::2]):
+        lo, hi = max(start - reach, 0), min(stop + reach, depth.size)
+        smooth = gaussian_filter1d(depth[lo:hi], sigma)[start - lo:stop - lo]
+        out[start:stop] = (1 - blend[start:stop]) * depth[start:stop] + blend[start:stop] * smooth
+    return out
 
 
 def _fractal(shape, rng, sigmas_px, amplitudes):
