@@ -318,11 +318,11 @@ def varied_campaign(tmp_path_factory) -> Path:
     tests/test_run_results_virtual.py. Read only."""
     from virtual_testbed import generate_campaign
     from virtual_testbed.sample_campaign import SAMPLE_RATES
-    from virtual_testbed.varied_campaign import varied_conditions
+    from virtual_testbed.varied_campaign import varied_conditions, varied_forms
 
     def make(path: Path) -> None:
         conditions = varied_conditions()
-        forms = {c.run_id: ("csv" if i % 3 == 0 else "mcap") for i, c in enumerate(conditions)}
-        generate_campaign(path, conditions, seed=11, rates=SAMPLE_RATES, form=forms)
+        generate_campaign(path, conditions, seed=11, rates=SAMPLE_RATES,
+                          form=varied_forms(conditions))
 
     return _once_per_run(tmp_path_factory, "varied_campaign_11", make)

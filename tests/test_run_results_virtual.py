@@ -19,7 +19,7 @@ import ingest
 from run_results import RigCompliance, process_run, results_table, towed_vs_powered
 from virtual_testbed import RunCondition, SensorModel, generate_campaign
 from virtual_testbed.sample_campaign import SAMPLE_RATES
-from virtual_testbed.varied_campaign import varied_conditions
+from virtual_testbed.varied_campaign import varied_conditions, varied_forms
 from virtual_testbed import Testbed as VirtualTestbed
 from virtual_testbed.grousers import oscillation_shape
 
@@ -53,8 +53,7 @@ def processed_no_drift(tmp_path_factory):
     sensors = SensorModel(force_drift_n=0.0, torque_drift_nm=0.0)
     out = tmp_path_factory.mktemp("results_no_drift")
     conditions = varied_conditions()
-    forms = {c.run_id: ("csv" if i % 3 == 0 else "mcap") for i, c in enumerate(conditions)}
-    generate_campaign(out, conditions, seed=12, rates=RATES, form=forms,
+    generate_campaign(out, conditions, seed=12, rates=RATES, form=varied_forms(conditions),
                       testbed=VirtualTestbed(sensors=sensors))
     return _processed(out)
 

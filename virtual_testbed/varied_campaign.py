@@ -25,3 +25,9 @@ def varied_conditions(seed: int = 7) -> list[RunCondition]:
             for i, (load, mp, slip) in enumerate([(180, 0, 0.92), (300, 0, 0.9), (250, 1, 0.93),
                                                    (120, 0, 0.96)])]
     return out
+
+
+def varied_forms(conditions: list[RunCondition]) -> dict[str, str]:
+    """Each run's file form: every third run a CSV folder, the others MCAP, so that one
+    campaign goes through both readers."""
+    return {c.run_id: ("csv" if i % 3 == 0 else "mcap") for i, c in enumerate(conditions)}

@@ -37,15 +37,12 @@ from testbeds.apart.campaign import (RESET_MIN, campaign_names, draw_campaign, l
                                      rig_inputs, run_row, start_times, truth_document,
                                      write_text)
 from testbeds.apart.effects import SIX
-from testbeds.apart.score import diagnose, score_campaign
+from testbeds.apart.score import P_FLOOR, diagnose, score_campaign
 from testbeds.apart.solver import NoEquilibrium
 from testbeds.apart.truth import REFERENCE_VELOCITY_MPS, RunSpec, WheelSpec
 from validation.second_rig import write_campaign
 
 ARMS = ("top", "random")
-#: a probability below this counts as this in a log (the scorer's floor,
-#: :func:`testbeds.apart.score.calibration`)
-P_FLOOR = 1e-12
 #: the files of a campaign folder a follow-up does not copy (the diagnosis' outputs)
 NOT_COPIED = ("*.sqlite", "gap*.json", "gap*.html", "failure.txt")
 
@@ -253,10 +250,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{name} ({r['truth']}): " + "; ".join(
             f"{arm}: {r[arm]['test']} ({r[arm]['gain_bits']:.2f} bit) -> {r[arm]['verdict']}"
             f"{' RESOLVED' if r[arm]['resolved'] else ''}" for arm in ARMS), flush=True)
-    n = len(results)
-    for arm in ARMS:
-        k = sum(r[arm]["resolved"] for r in results)
-        print(f"{arm}: {k}/{n} inconclusive campaigns resolved to the right answer")
+    print(markdown(results), end="")
     if args.json:
         write_text(args.json, json.dumps({"campaigns": results}, indent=1) + "\n")
     return 0

@@ -40,6 +40,8 @@ from testbeds.apart.detectability import TELLABLE_D, effect_distances, tellable
 from testbeds.apart.effects import SIX
 
 CLASSES = ("none", "single", "pair", "outside")
+#: a probability below this counts as this in a log (the log loss; a truth given 0)
+P_FLOOR = 1e-12
 
 
 def _write(path: Path, text: str) -> None:
@@ -209,7 +211,7 @@ def calibration(rows: list[dict]) -> dict:
 
     p_true = np.array([r["p_true"] for r in scored], float)
     return {"bins": bins, "confident_wrong": wrong, "n": n,
-            "log_loss": float(np.mean(-np.log(np.maximum(p_true, 1e-12)))) if scored else None,
+            "log_loss": float(np.mean(-np.log(np.maximum(p_true, P_FLOOR)))) if scored else None,
             "confident_wrong_upper_95": upper_95(wrong, n),
             "right_none_and_singles": rate(("none", "single"), "right"),
             "right_pairs": rate(("pair",), "right"),
