@@ -294,19 +294,27 @@ def _once_per_run(tmp_path_factory, name: str, make) -> Path:
 
 
 @pytest.fixture(scope="session")
-def processed_sample_db(tmp_path_factory) -> str:
-    """The committed sample campaign processed once per test run (:func:`_once_per_run`)
-    into a SQLite database (URL); each worker gets its own copy of it."""
-    from swtlab_cli.main import main
+def sample_reference_run(tmp_path_factory) -> Path:
+    """The committed sample campaign processed once per test run (:func:`_once_per_run`) on
+    the reference's pinned instruction set (``tests/reference/regenerate.py``): a folder
+    with ``swtlab.sqlite`` (as processed) and ``outputs.json`` (the normalised results, WPM
+    CSV and gap JSON the reference is compared with)."""
+    from tests.reference.regenerate import pinned_outputs
 
     def make(path: Path) -> None:
-        made = tmp_path_factory.mktemp("sample_db_made") / "swtlab.sqlite"
-        campaign = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
-        assert main(["process", str(campaign), "--db", f"sqlite:///{made}", "--quiet"]) == 0
-        _sqlite_copy(made, path)
+        path.mkdir()
+        made = pinned_outputs(keep_db=path / "swtlab.sqlite")
+        (path / "outputs.json").write_text(json.dumps(made))
 
+    return _once_per_run(tmp_path_factory, "sample_campaign", make)
+
+
+@pytest.fixture(scope="session")
+def processed_sample_db(sample_reference_run, tmp_path_factory) -> str:
+    """The committed sample campaign as processed (URL of a SQLite database); each worker
+    gets its own copy of it."""
     mine = tmp_path_factory.mktemp("sample_db") / "swtlab.sqlite"
-    _sqlite_copy(_once_per_run(tmp_path_factory, "sample_campaign.sqlite", make), mine)
+    _sqlite_copy(sample_reference_run / "swtlab.sqlite", mine)
     return f"sqlite:///{mine}"
 
 

@@ -13,14 +13,16 @@ run on: ``tests/reference/regenerate.py``).
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
-from tests.reference.regenerate import NAMES, REFERENCE, differences, pinned_outputs
+from tests.reference.regenerate import NAMES, REFERENCE, differences
 
 
 @pytest.fixture(scope="module")
-def now() -> dict[str, str]:
-    return pinned_outputs()
+def now(sample_reference_run) -> dict[str, str]:
+    return json.loads((sample_reference_run / "outputs.json").read_text())
 
 
 @pytest.mark.slow  # the sample campaign (60 runs) processed, exported and diagnosed

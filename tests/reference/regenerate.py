@@ -30,6 +30,7 @@ import io
 import json
 import math
 import os
+import sqlite3
 import subprocess
 import sys
 import tempfile
@@ -95,18 +96,25 @@ def outputs(db_url: str, workdir: Path, names: tuple[str, ...] = NAMES) -> dict[
     return out
 
 
-def _computed(names: tuple[str, ...]) -> dict[str, str]:
+def _computed(names: tuple[str, ...], keep_db: Path | None = None) -> dict[str, str]:
     with tempfile.TemporaryDirectory() as tmp:
         db_url = f"sqlite:///{Path(tmp) / 'swtlab.sqlite'}"
         _cli("process", str(CAMPAIGN), "--db", db_url, "--quiet")
+        if keep_db is not None:
+            with contextlib.closing(sqlite3.connect(Path(tmp) / "swtlab.sqlite")) as a, \
+                    contextlib.closing(sqlite3.connect(keep_db)) as b:
+                a.backup(b)
         return outputs(db_url, Path(tmp), names)
 
 
-def pinned_outputs(names: tuple[str, ...] = NAMES) -> dict[str, str]:
+def pinned_outputs(names: tuple[str, ...] = NAMES,
+                   keep_db: Path | None = None) -> dict[str, str]:
     """:func:`outputs` of the sample campaign processed afresh, computed in a child process
-    on :data:`PINNED_ISA`."""
+    on :data:`PINNED_ISA`; ``keep_db``: where to keep a copy of the processed database as it
+    was before the outputs were made."""
+    keep = [] if keep_db is None else ["--keep-db", str(keep_db)]
     done = subprocess.run([sys.executable, "-m", "tests.reference.regenerate", "--print",
-                           *names], cwd=ROOT, env={**os.environ, **PINNED_ISA},
+                           *keep, *names], cwd=ROOT, env={**os.environ, **PINNED_ISA},
                           capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(f"the pinned reference run failed:\n{done.stderr[-3000:]}")
@@ -168,13 +176,14 @@ def differences(name: str, reference: str, now: str) -> list[str]:
 
 def main(argv: list[str]) -> int:
     printing = argv[:1] == ["--print"]
-    names = tuple(argv[1:] if printing else argv) or NAMES
+    keep_db = Path(argv[2]) if printing and argv[1:2] == ["--keep-db"] else None
+    names = tuple(argv[3 if keep_db else 1 if printing else 0:]) or NAMES
     unknown = sorted(set(names) - set(NAMES))
     if unknown:
         print(f"unknown output(s) {unknown}; known: {list(NAMES)}", file=sys.stderr)
         return 2
     if printing:
-        print(json.dumps(_computed(names)))
+        print(json.dumps(_computed(names, keep_db)))
         return 0
     REFERENCE.mkdir(parents=True, exist_ok=True)
     for name, text in pinned_outputs(names).items():
