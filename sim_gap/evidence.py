@@ -220,11 +220,11 @@ class CovarianceTerms:
     copy (:mod:`sim_gap.bagging`) takes them once and combines them at each hypothesis'
     sizes."""
 
-    noise: np.ndarray
+    noise: np.ndarray  # the diagonal of the noise term
     offsets: np.ndarray
     shared: np.ndarray
     grouped: np.ndarray
-    floor: np.ndarray
+    floor: np.ndarray  # the diagonal of the nugget term
     run: np.ndarray | None
     per_run: np.ndarray
 
@@ -236,17 +236,22 @@ class CovarianceTerms:
         per_run = np.ones(take.size) if times is None else times
         ix = np.ix_(take, take)
         offsets = obs.offsets[take]
-        return cls(np.diag(obs.sigma[take] ** 2 / per_run),
+        return cls(obs.sigma[take] ** 2 / per_run,
                    OFFSET_PRIOR_SD_M ** 2 * offsets @ offsets.T,
                    obs.kernel_shared[ix], obs.kernel_grouped[ix],
-                   np.diag(obs.floor[take] ** 2 / per_run),
+                   obs.floor[take] ** 2 / per_run,
                    None if obs.kernel_run is None else obs.kernel_run[ix], per_run)
 
     def at(self, sizes: Sequence[float]) -> np.ndarray:
-        """``A`` at ``sizes = (t, o, v, g)``."""
+        """``A`` at ``sizes = (t, o, v, g)``: the terms added in that order (the diagonal
+        ones only where they are not zero, which adds nothing elsewhere)."""
         t, o, v, g = sizes
-        a = (self.noise + self.offsets + t ** 2 * self.shared + o ** 2 * self.grouped
-             + v ** 2 * self.floor)
+        a = self.offsets.copy()
+        diagonal = np.einsum("ii->i", a)
+        diagonal += self.noise
+        a += t ** 2 * self.shared
+        a += o ** 2 * self.grouped
+        diagonal += v ** 2 * self.floor
         if self.run is not None and g > 0:
             a += g ** 2 * self.run / self.per_run[:, None]
         return a
@@ -262,8 +267,11 @@ def covariances(obs: Observations, outside: np.ndarray | None = None) -> Covaria
     terms = CovarianceTerms.of(obs)
     # each factor column-major, as LAPACK reads it: grid_log_evidence's triangular solves
     # would copy a row-major one at every call
-    lower = np.array([cholesky(terms.at(s), lower=True, check_finite=False).T
-                      for s in sizes]).transpose(0, 2, 1)
+    n = obs.y.size
+    upper = np.empty((len(sizes), n, n))
+    for i, size in enumerate(sizes):
+        upper[i] = cholesky(terms.at(size), lower=True, check_finite=False).T
+    lower = upper.transpose(0, 2, 1)
     log_det = 2.0 * np.sum(np.log(np.diagonal(lower, axis1=1, axis2=2)), axis=1)
     return Covariances(lower, log_det,
                        (len(TAU_GRID), len(outside), len(NUGGET_GRID), len(run_grid)), sizes)
