@@ -27,7 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim_gap.evidence import Covariances, CovarianceTerms, Observations, grid_log_evidence
+from sim_gap.evidence import (Covariances, CovarianceTerms, Observations, PriorTerms,
+                              prepared_log_evidence)
 from sim_gap.decide import posterior
 
 #: bootstrap copies: the Monte Carlo error of a probability near the 0.9 of a call is then
@@ -78,6 +79,10 @@ def bagged_posterior(models: dict[str, BagModel], prior: dict[str, float], eta: 
     point = models[keys[0]].obs.point
     n_points = int(point.max()) + 1
     total = dict.fromkeys(keys, 0.0)
+    # what a copy does not change, once: the prior's terms, the MAP predictions as the
+    # evidence reads them
+    priors = {key: PriorTerms.of(models[key].sd, models[key].bounds) for key in keys}
+    predicted = {key: np.nan_to_num(models[key].predicted, nan=0.0) for key in keys}
     for _ in range(n_bags):
         take, times = resample(point, rng.multinomial(n_points,
                                                       np.full(n_points, 1 / n_points)))
@@ -91,9 +96,10 @@ def bagged_posterior(models: dict[str, BagModel], prior: dict[str, float], eta: 
                 if id(m.obs) not in terms:
                     terms[id(m.obs)] = CovarianceTerms.of(m.obs, take, times)
                 factors[cache] = _factor(terms[id(m.obs)].at(m.grid))
-            logs[key] = m.occam + float(grid_log_evidence(
-                factors[cache], m.obs.y[take], m.predicted[take], m.jac[take], m.offset,
-                m.sd, m.bounds)[0])
+            jac = m.jac[take]
+            residual = m.obs.y[take] - predicted[key][take] + jac @ m.offset
+            logs[key] = m.occam + float(prepared_log_evidence(
+                factors[cache], residual, jac, priors[key])[0])
         for key, p in posterior(logs, prior, eta).items():
             total[key] += p / n_bags
     return total

@@ -359,34 +359,59 @@ def grid_log_evidence(cov: Covariances, y: np.ndarray, predicted: np.ndarray, ja
     pushing the wheel). The box probabilities are taken as products of the marginal ones
     (exact for uncorrelated parameters; O'Hagan & Leonard 1976 for the one-sided case)."""
     residual = y - np.nan_to_num(predicted, nan=0.0) + jac @ offset_from_prior
-    prior_var = prior_sd ** 2
+    return prepared_log_evidence(cov, residual, jac, PriorTerms.of(prior_sd, bounds_from_prior))
+
+
+@dataclass(frozen=True)
+class PriorTerms:
+    """What :func:`grid_log_evidence` needs of a candidate's prior, computed once: a bagged
+    posterior (:mod:`sim_gap.bagging`) evaluates the same candidate on 200 copies."""
+
+    sd: np.ndarray
+    bounds: tuple[np.ndarray, np.ndarray] | None
+    precision: np.ndarray
+    log_det: float
+    in_box: float | None
+    identity: np.ndarray
+
+    @classmethod
+    def of(cls, prior_sd: np.ndarray,
+           bounds_from_prior: tuple[np.ndarray, np.ndarray] | None = None) -> PriorTerms:
+        prior_var = prior_sd ** 2
+        in_box = None
+        if bounds_from_prior is not None:
+            lo, hi = bounds_from_prior
+            in_box = np.sum(_log_interval(lo / prior_sd, hi / prior_sd))
+        return cls(prior_sd, bounds_from_prior, np.diag(1.0 / prior_var),
+                   np.sum(np.log(prior_var)), in_box, np.eye(prior_sd.size))
+
+
+def prepared_log_evidence(cov: Covariances, residual: np.ndarray, jac: np.ndarray,
+                          prior: PriorTerms) -> np.ndarray:
+    """:func:`grid_log_evidence` from the residual ``r = y - eta* + J (u* - mu)`` and the
+    prior's terms."""
     rhs = np.column_stack([residual, jac])
-    if bounds_from_prior is not None:
-        lo, hi = bounds_from_prior
-        prior_in_box = np.sum(_log_interval(lo / prior_sd, hi / prior_sd))
     # what every grid point shares is computed once, and the box probabilities of all grid
     # points in one call: the loop runs thousands of times per diagnosis on small matrices
     n_grid, n_params = cov.log_det.size, jac.shape[1]
     logs = np.empty(n_grid)
     mean, sd = np.empty((n_grid, n_params)), np.empty((n_grid, n_params))
-    prior_precision = np.diag(1.0 / prior_var)
-    log_prior_det = np.sum(np.log(prior_var))
     gauss_norm = 0.5 * residual.size * np.log(2.0 * np.pi)
-    identity = np.eye(n_params)
     for g, (factor, log_det) in enumerate(zip(cov.lower, cov.log_det)):
         x = _lapack(dtrtrs, factor, rhs, lower=1)
         xr, xj = x[:, 0], x[:, 1:]
         b = xj.T @ xr
-        m_factor = _lapack(dpotrf, prior_precision + xj.T @ xj, lower=1, clean=1)
+        m_factor = _lapack(dpotrf, prior.precision + xj.T @ xj, lower=1, clean=1)
         w = _lapack(dtrtrs, m_factor, b, lower=1)
         logs[g] = (-0.5 * (xr @ xr - w @ w) - 0.5 * log_det
-                   - 0.5 * (log_prior_det + 2.0 * np.sum(np.log(np.diagonal(m_factor))))
+                   - 0.5 * (prior.log_det + 2.0 * np.sum(np.log(np.diagonal(m_factor))))
                    - gauss_norm)
-        if bounds_from_prior is not None:
-            post_cov = _lapack(dpotrs, m_factor, identity, lower=1)
+        if prior.bounds is not None:
+            post_cov = _lapack(dpotrs, m_factor, prior.identity, lower=1)
             mean[g], sd[g] = post_cov @ b, np.sqrt(np.diagonal(post_cov))
-    if bounds_from_prior is not None:
-        logs += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd), axis=1) - prior_in_box
+    if prior.bounds is not None:
+        lo, hi = prior.bounds
+        logs += np.sum(_log_interval((lo - mean) / sd, (hi - mean) / sd), axis=1) - prior.in_box
     return logs
 
 
