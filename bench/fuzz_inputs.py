@@ -53,10 +53,12 @@ CSV_CELLS = ("", "x", "nan", "inf", "-inf", "1e400", "1" + "0" * 400, "True", "1
 
 @dataclass(frozen=True)
 class Case:
-    """One input: ``kind`` (what was mutated), ``what`` (how), and ``write(folder)``, which
-    writes it under ``folder`` and returns (run path, channel map or None)."""
+    """One input: ``kind`` (what was mutated), ``how`` (which of the kind's mutations),
+    ``what`` (the mutation in full), and ``write(folder)``, which writes it under ``folder``
+    and returns (run path, channel map or None)."""
 
     kind: str
+    how: str
     what: str
     write: Callable[[Path], tuple[Path, str | None]]
 
@@ -107,7 +109,7 @@ def _mcap_bytes(rng, run_id: str) -> Case:
         path = folder / f"{run_id}.mcap"
         path.write_bytes(bytes(data))
         return path, None
-    return Case("mcap_bytes", f"{run_id}: {how} at {at}", write)
+    return Case("mcap_bytes", how, f"{run_id}: {how} at {at}", write)
 
 
 def _sensor_messages(content: McapContent) -> list[int]:
@@ -154,7 +156,8 @@ def _json_block(rng, run_id: str) -> Case:
 
     def write(folder: Path):
         return write_content(folder / f"{run_id}.mcap", content), None
-    return Case("json_block", f"{run_id} {message.topic}: {how} {name} = {value[:24]}", write)
+    return Case("json_block", how, f"{run_id} {message.topic}: {how} {name} = {value[:24]}",
+                write)
 
 
 def _channel(rng, run_id: str) -> Case:
@@ -189,7 +192,7 @@ def _channel(rng, run_id: str) -> Case:
 
     def write(folder: Path):
         return write_content(folder / f"{run_id}.mcap", content), None
-    return Case("channel", f"{run_id} {topic}.{name}: {how}", write)
+    return Case("channel", how, f"{run_id} {topic}.{name}: {how}", write)
 
 
 def _metadata(rng, run_id: str) -> Case:
@@ -213,7 +216,7 @@ def _metadata(rng, run_id: str) -> Case:
 
     def write(folder: Path):
         return write_content(folder / f"{run_id}.mcap", content), None
-    return Case("metadata", f"{run_id} {record}.{key}: {how} {value[:24]!r}", write)
+    return Case("metadata", how, f"{run_id} {record}.{key}: {how} {value[:24]!r}", write)
 
 
 def _copy_csv_run(run_id: str, folder: Path) -> Path:
@@ -243,7 +246,7 @@ def _csv_cell(rng, run_id: str) -> Case:
         path = _copy_csv_run(run_id, folder)
         (path / name).write_text("\n".join(lines) + "\n")
         return path, None
-    return Case("csv_cell", f"{run_id}/{name}: {how} line {row}", write)
+    return Case("csv_cell", how, f"{run_id}/{name}: {how} line {row}", write)
 
 
 def _run_json(rng, run_id: str) -> Case:
@@ -266,7 +269,7 @@ def _run_json(rng, run_id: str) -> Case:
         path = _copy_csv_run(run_id, folder)
         (path / "run.json").write_text(text)
         return path, None
-    return Case("run_json", f"{run_id} {record}.{key}: {how} {value[:24]}", write)
+    return Case("run_json", how, f"{run_id} {record}.{key}: {how} {value[:24]}", write)
 
 
 def _channel_map(rng) -> Case:
@@ -298,7 +301,7 @@ def _channel_map(rng) -> Case:
             path.write_text("".join(source.read_text().splitlines(True)[:CMU_LINES]))
             return path, str(cmap)
         return _copy_csv_run(run_id, folder), str(cmap)
-    return Case("channel_map", f"{'cmu' if on_cmu else 'spec'} map: {how} {key} = {value}",
+    return Case("channel_map", how, f"{'cmu' if on_cmu else 'spec'} map: {how} {key} = {value}",
                 write)
 
 
@@ -339,7 +342,7 @@ def _format_file(rng, run_id: str) -> Case:
             data[i:i + 8] = bytes(b ^ 0xFF for b in data[i:i + 8])
         target.write_bytes(bytes(data))
         return path, cmap
-    return Case("format_file", what, write)
+    return Case("format_file", how, what, write)
 
 
 def _cmu_file(rng) -> Case:
@@ -360,7 +363,7 @@ def _cmu_file(rng) -> Case:
         path = folder / source.name
         path.write_text("".join(lines))
         return path, CMU_MAP
-    return Case("cmu_file", f"{source.parent.name}/{source.name}: {how}", write)
+    return Case("cmu_file", how, f"{source.parent.name}/{source.name}: {how}", write)
 
 
 #: case kinds and their weights

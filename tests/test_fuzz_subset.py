@@ -1,31 +1,67 @@
-"""A seeded subset of the reliability bench's fuzzing (``python -m bench reliability``): 500
-mutated real runs through the pipeline, none an unhandled exception, a hang, or a
-physically impossible value marked ok."""
+"""A seeded subset of the reliability bench's fuzzing (``python -m bench reliability``: 10,500
+inputs of seed 17): every mutation the generator (``bench.fuzz_inputs``) has, three times, through
+the pipeline; none an unhandled exception, a hang, or a physically impossible value marked ok.
+
+The subset: among cases 0-499 of seed 1 (this test's former 500 inputs), the first three of
+each (kind, how) pair, the 40 mutations of the 9 input kinds listed in ``MUTATIONS``; 120
+inputs, each kind 9 to 24 times. Finding rare faults by volume is the bench's job."""
 
 from __future__ import annotations
 
-import pytest
-
 from collections import Counter
 
+import pytest
+
 from bench.bench_reliability import fuzz
+from bench.fuzz_inputs import case
 from bench.fuzz_outcome import nonsense
 
 SEED = 1  # the bench itself runs seed 17
-INPUTS = 500
+POOL = 500  # cases 0-499 of SEED, from which the subset is taken
+PER_MUTATION = 3
+#: the mutations of each kind of input (the ``how`` of bench.fuzz_inputs' case functions)
+MUTATIONS = {
+    "mcap_bytes": {"flip", "cut", "insert", "zero"},
+    "json_block": {"sample", "t_ns", "drop_key", "add_key", "short", "payload", "scale",
+                   "swap_t"},
+    "channel": {"scale", "negate", "offset", "flat", "clip", "spikes", "freeze"},
+    "metadata": {"set", "drop", "new", "drop_record"},
+    "csv_cell": {"cell", "drop_line", "cut", "header", "junk_line"},
+    "run_json": {"set", "drop", "text"},
+    "channel_map": {"set", "drop", "csv_file"},
+    "cmu_file": {"cut", "cell", "junk"},
+    "format_file": {"channel", "bytes", "cut"},
+}
 
 
-@pytest.mark.slow  # 500 mutated runs, each read and processed
+def _subset() -> tuple[list[int], Counter]:
+    """Indices of the first ``PER_MUTATION`` cases of every (kind, how) among cases
+    0..POOL-1, and how many of each were taken."""
+    taken: Counter = Counter()
+    indices = []
+    for i in range(POOL):
+        item = case(SEED, i)
+        if taken[item.kind, item.how] < PER_MUTATION:
+            taken[item.kind, item.how] += 1
+            indices.append(i)
+    return indices, taken
+
+
+@pytest.mark.slow  # 120 mutated runs, each read and processed
 @pytest.mark.slow_campaign
-def test_five_hundred_mutated_runs_fail_cleanly_or_give_sound_results():
-    counts, faults = fuzz(INPUTS, SEED)
+def test_every_mutation_three_times_fails_cleanly_or_gives_sound_results():
+    indices, taken = _subset()
+    # every mutation of every kind is in the subset, each three times
+    assert set(taken) == {(kind, how) for kind, hows in MUTATIONS.items() for how in hows}
+    assert set(taken.values()) == {PER_MUTATION}
+    counts, faults = fuzz(indices, SEED)
     total = sum(counts.values(), Counter())
-    assert sum(total.values()) == INPUTS
+    assert sum(total.values()) == len(indices) == PER_MUTATION * len(taken)
     assert faults == []
-    # every kind of input was tried, and the mutations both break runs and leave some usable
-    assert set(counts) == {"mcap_bytes", "json_block", "channel", "metadata", "csv_cell",
-                           "run_json", "channel_map", "cmu_file", "format_file"}
-    assert total["refused"] > 0.5 * INPUTS and total["ok"] + total["flagged"] > 0.1 * INPUTS
+    assert all(sum(counts[kind].values()) >= PER_MUTATION for kind in MUTATIONS)
+    # the mutations both break runs and leave some usable
+    assert total["refused"] > 0.5 * len(indices)
+    assert total["ok"] + total["flagged"] > 0.1 * len(indices)
 
 
 def test_the_nonsense_judge_catches_an_impossible_result():

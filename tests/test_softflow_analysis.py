@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import functools
 import json
 
 import numpy as np
@@ -16,22 +15,12 @@ from virtual_testbed.flow_render import (FlowScene, default_radial_decay_per_m,
                                          write_flow_render)
 
 
-@functools.lru_cache(maxsize=None)
-def _render(seed: int):
-    scene = FlowScene(seed=seed)
-    return scene, render_flow(scene, 10)
-
-
-@pytest.fixture(scope="module", params=[5, 9])
-def smooth_wheels(request):
-    """Two renders for the accuracy check."""
-    return _render(request.param)
-
-
 @pytest.fixture(scope="module")
 def smooth_wheel():
-    """One of them for the checks of the outputs' form (the same path on either render)."""
-    return _render(5)
+    """Ten frames of the default smooth-wheel scene, seed 5: for the accuracy check and the
+    checks of the outputs' form."""
+    scene = FlowScene(seed=5)
+    return scene, render_flow(scene, 10)
 
 
 @pytest.fixture(scope="module")
@@ -48,10 +37,20 @@ def _contact(result):
     return (beta < -np.deg2rad(20)) & (beta > -np.deg2rad(160))
 
 
-@pytest.mark.slow  # optical flow on ten rendered frames, two renders
+@pytest.mark.slow  # optical flow on ten rendered frames
 @pytest.mark.slow_render
-def test_decay_rates_within_5_percent(smooth_wheels):
-    scene, r = smooth_wheels
+def test_decay_rates_within_5_percent(smooth_wheel):
+    """Every defined contact bin's ``k`` and ``alpha3`` within 5 % of the truth (the issue's
+    target, per bin, whatever the number of bins) on one render: 10 bins of each.
+
+    A regression check; the record is the bench's (``bench_softflow.decay_and_grousers``:
+    seeds 5-9, this scene, ten frames, every contact bin; docs/validation/softflow.md: ``k``
+    within 3 %, ``alpha3`` within 4.5 %). The suite checked seeds 5 and 9 (40 bins); seed 5
+    alone (measured largest errors 1.3 % and 1.6 %; seed 9's 0.7 % and 2.5 %) catches a
+    regression that puts a fraction q of bins beyond 5 % with probability 1 - (1 - q)^20
+    if bins failed independently: 0.88 at q = 0.1, 0.96 at q = 0.15 (two renders: 0.985,
+    0.998)."""
+    scene, r = smooth_wheel
     res = analyse_frames(r.frames, r.t_s, scene.px_per_m)
     contact = _contact(res)
     theta = res.beta_rad + np.pi / 2

@@ -20,7 +20,8 @@ from virtual_testbed.track_render import (
 
 RADIUS_M, GROUSERS, HEIGHT_M = 0.125, 12, 0.0092  # BB2-like wheel
 SIZE_PX = (800, 600)
-RENDERS = 50
+RENDERS = 20
+MAX_OFF = 1  # renders allowed off by more than 0.5 pp (refusals count as off)
 
 
 def _random_render(i: int):
@@ -33,9 +34,20 @@ def _random_render(i: int):
                         nuisance=random_nuisance(20_000 + i, (640, 480)))
 
 
-@pytest.mark.slow  # 50 track photos rendered and measured
+@pytest.mark.slow  # 20 track photos rendered and measured
 @pytest.mark.slow_render
-def test_accuracy_over_50_random_renders():
+def test_accuracy_over_20_random_renders():
+    """A regression check of the accuracy target; the accuracy record itself is the bench's
+    (``python -m bench track_slip``, docs/track-slip.md).
+
+    Acceptance rule: at most ``MAX_OFF`` = 1 of the 20 renders off by more than 0.5 pp (a
+    refusal counts as off), and the median error below 0.1 pp. With the renders drawn
+    independently and a true within-0.5-pp rate p, the number off is Binomial(20, 1 - p):
+    P(pass | p = 0.80) = 0.8^20 + 20 * 0.2 * 0.8^19 = 0.069 (93 % power to catch a drop to
+    80 %), P(fail | p = 0.99) = 1 - 0.99^20 - 20 * 0.01 * 0.99^19 = 0.017 (the target is 95 %;
+    the bench measures 98-100 %). The former 50 renders with 95 % (at most 2 off) had
+    P(pass | 0.80) = 0.001 and P(fail | 0.99) = 0.014.
+    """
     errors_pp, refused = [], 0
     for i in range(RENDERS):
         image, truth = _random_render(i)
@@ -47,8 +59,8 @@ def test_accuracy_over_50_random_renders():
             continue
         errors_pp.append(100 * abs(result.slip - truth["slip"]))
     errors_pp = np.array(errors_pp)
-    within = np.mean(errors_pp <= 0.5)
-    assert within >= 0.95, (f"{within:.0%} within 0.5 pp, {refused} refused, "
+    off = int(np.sum(errors_pp > 0.5))
+    assert off <= MAX_OFF, (f"{off} of {RENDERS} off by more than 0.5 pp, {refused} refused, "
                             f"errors {np.round(np.sort(errors_pp)[-6:], 2)}")
     assert np.median(errors_pp) < 0.1
 
