@@ -21,11 +21,11 @@ def pytest_configure(config) -> None:
     """Each pytest-xdist worker (``make test``: one per core) runs numba and BLAS (OpenCV's
     and scipy's too) on its share of the cores, as a ``swtlab process --jobs`` worker does:
     two workers of two BLAS threads each on two cores wait for each other's threads
-    (softflow.threads; the 62 track photos of tests/test_track_slip*.py on a busy 2-core
-    machine: 81 s, 41 s on one thread). OpenCV's own threads are left as they are:
-    tests/test_process_parallel.py forks workers after this process used OpenCV's thread
-    pool. The results do not depend on the thread count (tests/test_softflow_threads.py sets
-    its own; those 62 results are equal)."""
+    (softflow.threads; 62 track photos measured on a busy 2-core machine: 81 s, 41 s on one
+    thread). OpenCV's own threads are left as they are: tests/test_process_parallel.py forks
+    workers after this process used OpenCV's thread pool. The results do not depend on the
+    thread count (tests/test_softflow_threads.py sets its own; those 62 results were
+    equal)."""
     workers = os.environ.get("PYTEST_XDIST_WORKER_COUNT")
     if workers and os.environ.get("PYTEST_XDIST_WORKER"):
         import scipy.linalg  # noqa: F401  (its BLAS, loaded now, is limited too)
