@@ -16,10 +16,10 @@ and commits the changed files with the change (``git diff`` shows what moved).
 ``tests/test_reference_sample.py`` checks the code against them.
 
 Both compute in a child process on one pinned instruction set (:data:`PINNED_ISA`): NumPy's
-AVX-512 kernels, OpenBLAS' per-CPU kernels and Numba's host target otherwise round the last
-bits differently from machine to machine, and an optimiser that stops a few ulps elsewhere
-can move a stable window by one sample (seen: 6 of the 60 sample runs between an AVX-512
-machine and an AVX2 one).
+AVX-512 kernels, OpenBLAS' per-CPU kernels, Numba's host target and OpenCV's AVX-512 kernels
+otherwise round the last bits differently from machine to machine, and an optimiser that
+stops a few ulps elsewhere can move a stable window by one sample (seen: 6 of the 60 sample
+runs between an AVX-512 machine and an AVX2 one).
 """
 
 from __future__ import annotations
@@ -47,10 +47,12 @@ UNSTABLE_KEYS = {"swtlab_version", "version", "created", "created_at"}
 #: another order (last bits); a change a commit means is many orders larger
 REL_TOL = 1e-9
 #: one x86-64 code path on every machine with AVX2: NumPy's AVX-512 dispatch targets off
-#: (names as NumPy 2.4 knows them), OpenBLAS' Haswell kernels on one thread, Numba for Haswell
+#: (names as NumPy 2.4 knows them), OpenBLAS' Haswell kernels on one thread, Numba for
+#: Haswell, OpenCV without AVX-512 (its AVX512_SKX kernels need AVX512F; on a machine
+#: without it OpenCV says on stderr that there is nothing to disable)
 PINNED_ISA = {"NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL AVX512_SPR",
               "OPENBLAS_CORETYPE": "Haswell", "OPENBLAS_NUM_THREADS": "1",
-              "NUMBA_CPU_NAME": "haswell"}
+              "NUMBA_CPU_NAME": "haswell", "OPENCV_CPU_DISABLE": "AVX512F"}
 
 
 def _cli(*argv: str) -> None:
