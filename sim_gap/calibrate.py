@@ -24,7 +24,7 @@ import pandas as pd
 from scipy.optimize import least_squares
 
 import terramechanics as tm
-from sim_gap.fit import quantities_of, sigmas, standardised_residuals
+from sim_gap.fit import quantities_of, sigmas, standardiser
 from sim_gap.priors import ParamPrior, soil_prior
 from sim_gap.simulated import Simulated
 
@@ -129,10 +129,11 @@ def calibrate_soil(points: pd.DataFrame, model: tm.WheelModel,
     centre = np.array([prior[n].centre for n in names])
     spread = np.array([prior[n].spread for n in names])
 
+    predict, standardised = sim.predictor(points), standardiser(points)
+
     def data_residuals(u, scale):
         scaled = {q: sig[q] * scale[q] for q in quantities}
-        r = standardised_residuals(points, sim.predict(points, _to_values(names, log, u)),
-                                   scaled, np.inf)
+        r = standardised(predict(_to_values(names, log, u)), scaled, np.inf)
         return np.nan_to_num(r, nan=1e3, posinf=1e3, neginf=-1e3)
 
     def fit(u0, scale):

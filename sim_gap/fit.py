@@ -70,9 +70,22 @@ def standardised_residuals(points: pd.DataFrame, predicted: dict[str, np.ndarray
     """``(measured - predicted)/sigma`` clipped to ``+-clip``, shape (points, quantities);
     NaN where not measured. A relative sinkage (``attrs['sinkage_relative']``) has its mean
     removed."""
+    return standardiser(points)(predicted, sigma, clip)
+
+
+def standardiser(points: pd.DataFrame) -> Callable[..., np.ndarray]:
+    """:func:`standardised_residuals` at fixed ``points``, their columns read once: a fit
+    calls it hundreds of times, and each column read costs pandas a deep copy of the
+    points' ``attrs``."""
     quantities = quantities_of(points)
-    return _standardised(points[quantities].to_numpy(float), quantities, predicted, sigma,
-                         bool(points.attrs.get("sinkage_relative")), clip)
+    measured = points[quantities].to_numpy(float)
+    relative = bool(points.attrs.get("sinkage_relative"))
+
+    def standardised(predicted: dict[str, np.ndarray], sigma: dict[str, np.ndarray],
+                     clip: float = RESIDUAL_CLIP) -> np.ndarray:
+        return _standardised(measured, quantities, predicted, sigma, relative, clip)
+
+    return standardised
 
 
 def _standardised(measured: np.ndarray, quantities: list[str],

@@ -309,14 +309,15 @@ def _prediction(sim: Simulated, h: _Hypothesis, grid: pd.DataFrame, quantities: 
                 ) -> tuple[np.ndarray, np.ndarray]:
     """The MAP prediction (flat) at ``grid`` and its finite-difference Jacobian."""
     c, u = h.f.fit.candidate, h.f.internal
-    mean = _flat(sim.predict(grid, to_values(c, u)), quantities)
+    predict = sim.predictor(grid)
+    mean = _flat(predict(to_values(c, u)), quantities)
     jac = np.zeros((mean.size, u.size))
     for i in range(u.size):
         step = JACOBIAN_STEP * (h.hi[i] - h.lo[i])
         step = -step if u[i] + step > h.hi[i] else step
         v = u.copy()
         v[i] += step
-        jac[:, i] = (_flat(sim.predict(grid, to_values(c, v)), quantities) - mean) / step
+        jac[:, i] = (_flat(predict(to_values(c, v)), quantities) - mean) / step
     return mean, jac
 
 
