@@ -367,7 +367,6 @@ class PriorTerms:
     """What :func:`grid_log_evidence` needs of a candidate's prior, computed once: a bagged
     posterior (:mod:`sim_gap.bagging`) evaluates the same candidate on 200 copies."""
 
-    sd: np.ndarray
     bounds: tuple[np.ndarray, np.ndarray] | None
     precision: np.ndarray
     log_det: float
@@ -382,7 +381,7 @@ class PriorTerms:
         if bounds_from_prior is not None:
             lo, hi = bounds_from_prior
             in_box = np.sum(_log_interval(lo / prior_sd, hi / prior_sd))
-        return cls(prior_sd, bounds_from_prior, np.diag(1.0 / prior_var),
+        return cls(bounds_from_prior, np.diag(1.0 / prior_var),
                    np.sum(np.log(prior_var)), in_box, np.eye(prior_sd.size))
 
 

@@ -104,13 +104,9 @@ def residual_function(sim: Simulated, points: pd.DataFrame, sigma: dict[str, np.
                       ) -> Callable[[dict[str, float | str]], np.ndarray]:
     """Model values -> the unclipped standardised residuals of the measured entries (flat),
     with the points' columns read once: a fit evaluates it hundreds of times."""
-    quantities = quantities_of(points)
-    measured = points[quantities].to_numpy(float)
     where = independent_entries(points)
-    relative = bool(points.attrs.get("sinkage_relative"))
-    predict = sim.predictor(points)
-    return lambda values: _standardised(measured, quantities, predict(values), sigma,
-                                        relative, np.inf)[where]
+    predict, standardised = sim.predictor(points), standardiser(points)
+    return lambda values: standardised(predict(values), sigma, np.inf)[where]
 
 
 def to_values(c: Candidate, u: np.ndarray) -> dict[str, float | str]:

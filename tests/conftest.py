@@ -5,7 +5,6 @@ whose true SI values are known."""
 from __future__ import annotations
 
 import base64
-import contextlib
 import json
 import os
 from dataclasses import dataclass, field
@@ -265,15 +264,6 @@ def db_url(request, tmp_path):
     admin.dispose()
 
 
-def _sqlite_copy(source: Path, target: Path) -> None:
-    """``source`` copied to ``target`` by SQLite's backup (the same database, page for page)."""
-    import sqlite3
-
-    with contextlib.closing(sqlite3.connect(source)) as a, \
-            contextlib.closing(sqlite3.connect(target)) as b:
-        a.backup(b)
-
-
 def _once_per_run(tmp_path_factory, name: str, make) -> Path:
     """``name`` in the test run's shared folder, made by ``make(path)`` once per run: the
     pytest-xdist workers of one run share it, the first to need it makes it while the others
@@ -313,8 +303,10 @@ def sample_reference_run(tmp_path_factory) -> Path:
 def processed_sample_db(sample_reference_run, tmp_path_factory) -> str:
     """The committed sample campaign as processed (URL of a SQLite database); each worker
     gets its own copy of it."""
+    from tests.reference.regenerate import sqlite_copy
+
     mine = tmp_path_factory.mktemp("sample_db") / "swtlab.sqlite"
-    _sqlite_copy(sample_reference_run / "swtlab.sqlite", mine)
+    sqlite_copy(sample_reference_run / "swtlab.sqlite", mine)
     return f"sqlite:///{mine}"
 
 

@@ -24,6 +24,7 @@ runs between an AVX-512 machine and an AVX2 one).
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import csv
 import io
@@ -104,10 +105,15 @@ def _computed(names: tuple[str, ...], keep_db: Path | None = None) -> dict[str, 
         db_url = f"sqlite:///{Path(tmp) / 'swtlab.sqlite'}"
         _cli("process", str(CAMPAIGN), "--db", db_url, "--quiet")
         if keep_db is not None:
-            with contextlib.closing(sqlite3.connect(Path(tmp) / "swtlab.sqlite")) as a, \
-                    contextlib.closing(sqlite3.connect(keep_db)) as b:
-                a.backup(b)
+            sqlite_copy(Path(tmp) / "swtlab.sqlite", keep_db)
         return outputs(db_url, Path(tmp), names)
+
+
+def sqlite_copy(source: Path, target: Path) -> None:
+    """``source`` copied to ``target`` by SQLite's backup (the same database, page for page)."""
+    with contextlib.closing(sqlite3.connect(source)) as a, \
+            contextlib.closing(sqlite3.connect(target)) as b:
+        a.backup(b)
 
 
 def _pinned() -> dict[str, str]:
@@ -184,15 +190,18 @@ def differences(name: str, reference: str, now: str) -> list[str]:
 
 
 def main(argv: list[str]) -> int:
-    printing = argv[:1] == ["--print"]
-    keep_db = Path(argv[2]) if printing and argv[1:2] == ["--keep-db"] else None
-    names = tuple(argv[3 if keep_db else 1 if printing else 0:]) or NAMES
+    parser = argparse.ArgumentParser(prog="python -m tests.reference.regenerate")
+    parser.add_argument("names", nargs="*", help=f"some of {', '.join(NAMES)} (default: all)")
+    parser.add_argument("--print", action="store_true",
+                        help="compute here and print the outputs as JSON (the pinned child)")
+    parser.add_argument("--keep-db", type=Path, help="with --print: keep the processed database")
+    args = parser.parse_args(argv)
+    names = tuple(args.names) or NAMES
     unknown = sorted(set(names) - set(NAMES))
     if unknown:
-        print(f"unknown output(s) {unknown}; known: {list(NAMES)}", file=sys.stderr)
-        return 2
-    if printing:
-        print(json.dumps(_computed(names, keep_db)))
+        parser.error(f"unknown output(s) {unknown}; known: {list(NAMES)}")
+    if args.print:
+        print(json.dumps(_computed(names, args.keep_db)))
         return 0
     REFERENCE.mkdir(parents=True, exist_ok=True)
     for name, text in pinned_outputs(names).items():
