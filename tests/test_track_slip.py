@@ -38,7 +38,7 @@ def _random_render(i: int):
 @pytest.mark.slow_render
 def test_accuracy_over_20_random_renders():
     """A regression check of the accuracy target; the accuracy record itself is the bench's
-    (``python -m bench track_slip``, docs/track-slip.md).
+    (``python -m bench track_slip --markdown``, docs/validation/track_slip.md).
 
     Acceptance rule: at most ``MAX_OFF`` = 1 of the 20 renders off by more than 0.5 pp (a
     refusal counts as off), and the median error below 0.1 pp. With the renders drawn
