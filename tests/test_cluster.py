@@ -20,6 +20,8 @@ from virtual_testbed.flow_render import FlowScene, render_flow, write_flow_rende
 
 distributed = pytest.importorskip("distributed")
 
+pytestmark = pytest.mark.slow  # local Dask clusters started, frames rendered and measured on them
+
 
 @pytest.fixture(scope="module")
 def client():

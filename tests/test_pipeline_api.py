@@ -18,6 +18,9 @@ import terramechanics as tm
 from sim_gap.wheel_check import WheelMismatchError
 from swtlab_base.domain import COLUMNS, Wheel
 
+pytestmark = [pytest.mark.slow,  # the sample campaign processed and diagnosed through the API
+              pytest.mark.slow_campaign, pytest.mark.slow_diagnosis]
+
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data"
 LOADS = (70, 180, 300)
 SLIPS = ("-010", "+000", "+005", "+010", "+020", "+035", "+060", "+090")

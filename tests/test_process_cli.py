@@ -20,6 +20,9 @@ from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import ProcessingRecord, RawFile, RunQuantity, RunResult, StableWindow
 
+pytestmark = [pytest.mark.slow,  # campaigns processed by swtlab process, one batch killed midway
+              pytest.mark.slow_campaign, pytest.mark.slow_workers]
+
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data"
 QUANTITIES = ("slip", "travel_velocity_mps", "wheel_omega_radps", "wheel_load_n", "dp_n",
               "torque_nm", "thrust_n", "resistance_n", "sinkage_m")

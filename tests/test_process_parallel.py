@@ -20,6 +20,8 @@ from swtlab_base.cores import threads_per_worker
 from swtlab.pipeline.process import ProcessSettings, process_file, worker_pool
 from swtlab_cli.main import COMMANDS, command_module, main
 
+pytestmark = pytest.mark.slow  # sample runs processed serially, in a pool and on a cluster
+
 SAMPLE = Path(__file__).resolve().parents[1] / "sample_data" / "campaign"
 RUNS = ("L070_MP0_SC_s+010", "L180_MP0_SC_s+020", "L300_MP1_SC_s+035", "L180_MP0_TW",
         "L180_MP0_SC_s+090")

@@ -30,6 +30,9 @@ from traceability.models import Campaign, Run, TestCondition, WpmExport
 from traceability.queries import latest_results
 from wpm_export import WheelPerformanceModule
 
+pytestmark = [pytest.mark.slow,  # campaigns processed and rendered into pages
+              pytest.mark.slow_campaign]
+
 UNIT = re.compile(r"\[[^\]]+\]$")
 
 

@@ -23,6 +23,10 @@ from virtual_testbed.varied_campaign import varied_conditions, varied_forms
 from virtual_testbed import Testbed as VirtualTestbed
 from virtual_testbed.grousers import oscillation_shape
 
+pytestmark = [pytest.mark.slow,  # the 56-run varied campaign and campaigns with drifting
+              # load cells generated and processed
+              pytest.mark.slow_campaign]
+
 RATES = SAMPLE_RATES
 TRUTH_KEY = {"resistance_n": "motion_resistance_n"}
 LAW_KEY = {"slip": "slip", "dp_n": "dp_n", "torque_nm": "torque_nm", "thrust_n": "thrust_n",

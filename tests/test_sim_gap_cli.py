@@ -19,6 +19,10 @@ from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import GapReport
 
+pytestmark = [pytest.mark.slow,  # a virtual campaign generated, processed and diagnosed by the
+              # command
+              pytest.mark.slow_campaign, pytest.mark.slow_diagnosis]
+
 REQUIRED = {"verdict", "probability", "hypotheses", "effect_sets", "held_out_rmse_before",
             "held_out_rmse_after", "shrink_pct", "regions", "reason", "separating_test",
             "next_tests", "admissible_tests",

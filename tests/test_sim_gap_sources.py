@@ -18,6 +18,10 @@ from sim_gap.measured import combine, load_measured
 from sim_gap.points_csv import PointsFormatError, read_points_csv
 from sim_gap.simulated import Simulated
 
+pytestmark = [pytest.mark.slow,  # the processed sample campaign (made once per run) and
+              # diagnoses of the Ding and Wang sources
+              pytest.mark.slow_diagnosis]
+
 ROOT = Path(__file__).resolve().parents[1]
 DING_POINTS = ROOT / "sim_gap" / "data" / "ding2011_points.csv"
 DING_MODEL = ROOT / "sim_gap" / "models" / "ding2011_simulant.toml"

@@ -18,6 +18,8 @@ from swtlab_cli.main import main
 from traceability import open_database
 from traceability.models import RawFile, Run, RunResult
 
+pytestmark = pytest.mark.slow  # every test stores runs on SQLite and PostgreSQL (1-3 s each)
+
 
 def _write(path: Path, tools, fz_n: float = 150.0, **records) -> Path:
     """A spec MCAP at ``path`` whose set load is ``fz_n`` and whose hub measures ``fz_n``;
