@@ -373,6 +373,24 @@ def test_reliability_bins_count_each_campaign_once():
         np.linspace(0.3, 1.0, 30)) if p >= 0.9]))
 
 
+def test_reliability_per_class_of_the_truth():
+    """Two classes miscalibrated in opposite directions, which the pooled bins hide: singles
+    led rightly at 0.6 (stated 0.6, right 1.0), pairs led wrongly at 0.9 (a single leads;
+    stated 0.9, right 0.0); campaigns without probabilities are left out."""
+    from testbeds.apart.score import calibration, calibration_markdown
+
+    single = {"class": "single", "outcome": "inconclusive", "outside": [],
+              "effects": ["grousers"], "leading": "grousers", "p_leading": 0.6, "p_true": 0.6}
+    pair = {"class": "pair", "outcome": "wrong", "outside": [],
+            "effects": ["grousers", "bulldozing"], "leading": "grousers", "p_leading": 0.9,
+            "p_true": 0.05}
+    failed = {**single, "outcome": "failed", "p_leading": None, "p_true": None}
+    cal = calibration([single] * 4 + [pair] * 2 + [failed])
+    assert cal["by_class"] == {"single": {"n": 4, "stated": 0.6, "right": 1.0},
+                               "pair": {"n": 2, "stated": 0.9, "right": 0.0}}
+    assert "| pair | 2 | 0.90 | 0.00 |" in calibration_markdown(cal)
+
+
 @pytest.mark.slow  # one campaign (22 runs) through swtlab process and swtlab gap: about 20 s
 @pytest.mark.slow_campaign
 @pytest.mark.slow_diagnosis

@@ -190,7 +190,9 @@ def upper_95(k: int, n: int) -> float:
 def calibration(rows: list[dict]) -> dict:
     """Reliability of the stated probabilities: per decile of the leading hypothesis'
     probability, how many campaigns, their mean stated probability and the fraction whose
-    leading hypothesis is the truth; confident wrong calls (a named verdict, probability >=
+    leading hypothesis is the truth; the same per class of truth (``by_class``: a
+    reliability table pooled over classes can hide probabilities too low on one class and
+    too high on another); confident wrong calls (a named verdict, probability >=
     0.9, that is not the truth) with their 95 % upper bound; the issue's rates."""
     scored = [r for r in rows if r["p_leading"] is not None]
     bins = []
@@ -209,8 +211,16 @@ def calibration(rows: list[dict]) -> dict:
                and (r.get("tellable", True) or not tellable_only)]
         return (sum(r["outcome"] == outcome for r in sub), len(sub))
 
+    by_class = {}
+    for cls in CLASSES:
+        sub = [r for r in scored if r["class"] == cls]
+        if sub:
+            by_class[cls] = {"n": len(sub),
+                             "stated": float(np.mean([r["p_leading"] for r in sub])),
+                             "right": float(np.mean([bool(leading_is_right(r))
+                                                     for r in sub]))}
     p_true = np.array([r["p_true"] for r in scored], float)
-    return {"bins": bins, "confident_wrong": wrong, "n": n,
+    return {"bins": bins, "by_class": by_class, "confident_wrong": wrong, "n": n,
             "log_loss": float(np.mean(-np.log(np.maximum(p_true, P_FLOOR)))) if scored else None,
             "confident_wrong_upper_95": upper_95(wrong, n),
             "right_none_and_singles": rate(("none", "single"), "right"),
@@ -281,6 +291,11 @@ def calibration_markdown(cal: dict) -> str:
     for b in cal["bins"]:
         if b["n"]:
             lines.append(f"| {b['bin']} | {b['n']} | {b['stated']:.2f} | {b['right']:.2f} |")
+
+    lines += ["", "| class of the truth | campaigns | mean stated | leading is the truth |",
+              "|---|---|---|---|"]
+    lines += [f"| {cls} | {v['n']} | {v['stated']:.2f} | {v['right']:.2f} |"
+              for cls, v in cal.get("by_class", {}).items()]
 
     def frac(pair):
         k, n = pair
