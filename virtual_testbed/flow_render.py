@@ -400,17 +400,17 @@ def render_flow(scene: FlowScene, n_frames: int = 4) -> FlowRender:
     smudge_sig = rng.uniform(15, 50, scene.smudges)
     frames, disp, masks, covers = [], [], [], []
     qx0, qy0 = px.copy(), py.copy()  # texture position of each frame pixel (frame 0: itself)
-    last_velocity = (px, py)  # soil velocity at the pixels, frame before (set at each frame end)
     for k in range(n_frames):
         if k:
-            # Q_k = Q_{k-1} o phi_{k-1}^-1: invert the last map by fixed-point iteration,
-            # then sample the (smooth) previous map there, bicubically.
-            tx, ty = px, py
-            ux, uy = last_velocity  # the first iterate starts at the pixel itself
+            # the soil's displacement from frame k-1 to k at the pixels (the truth); then
+            # Q_k = Q_{k-1} o phi_{k-1}^-1: invert that map by fixed-point iteration starting
+            # at the pixels themselves, and sample the (smooth) previous map there, bicubically
+            ux, uy = _soil_velocity_px_per_frame(px, py, scene, t_s[k - 1], centers[k - 1])
+            disp.append(np.stack([ux, uy], axis=-1).astype(np.float32))
             for _ in range(5):
-                bx, by = tx - ux, ty - uy
-                ux, uy = _soil_velocity_px_per_frame(bx, by, scene, t_s[k - 1], centers[k - 1])
-            bx, by = tx - ux, ty - uy
+                ux, uy = _soil_velocity_px_per_frame(px - ux, py - uy, scene, t_s[k - 1],
+                                                     centers[k - 1])
+            bx, by = px - ux, py - uy
             qx0 = _sample(qx0, bx, by)
             qy0 = _sample(qy0, bx, by)
         qx, qy = _upsample(qx0, xs, ys), _upsample(qy0, xs, ys)
@@ -427,9 +427,6 @@ def render_flow(scene: FlowScene, n_frames: int = 4) -> FlowRender:
         img += scene.noise_std * rng.standard_normal(img.shape)
         frames.append(np.clip(np.rint(img), 0, 255).astype(np.uint8))
         covers.append(cover_px)
-        if k < n_frames - 1:
-            last_velocity = _soil_velocity_px_per_frame(px, py, scene, t_s[k], centers[k])
-            disp.append(np.stack(last_velocity, axis=-1).astype(np.float32))
     for k in range(n_frames - 1):
         masks.append((covers[k] == 0) & (covers[k + 1] == 0))
     render = FlowRender(scene, frames, t_s, np.array(disp), np.array(masks), centers,

@@ -295,7 +295,7 @@ def calibration_markdown(cal: dict) -> str:
     lines += ["", "| class of the truth | campaigns | mean stated | leading is the truth |",
               "|---|---|---|---|"]
     lines += [f"| {cls} | {v['n']} | {v['stated']:.2f} | {v['right']:.2f} |"
-              for cls, v in cal.get("by_class", {}).items()]
+              for cls, v in cal["by_class"].items()]
 
     def frac(pair):
         k, n = pair
