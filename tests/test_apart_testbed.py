@@ -405,3 +405,31 @@ def test_calibration_bench_runs_the_full_chain_on_a_subset(tmp_path):
     assert all(r["outcome"] != "failed" for r in result["campaigns"]), result["campaigns"]
     assert sum(b["n"] for b in result["calibration"]["bins"]) == 1
     assert all(0.0 <= r["p_true"] <= 1.0 for r in result["campaigns"])
+
+
+def test_misfit_after_soil_recalibration_per_class(tmp_path):
+    """Hand-made reports: a no-effect campaign whose points miss by 3 sigma in each quantity
+    (RMS 3), a bulldozing single called "no missing effect" missing by 1 sigma (RMS 1),
+    a campaign without a report left out."""
+    from testbeds.apart.misfit import misfits, summary
+
+    def point(z):
+        return {q: {"measured": 1.0 + z * 0.5, "soil_only": 1.0, "sigma": 0.5}
+                for q in ("dp_n", "torque_nm", "sinkage_m")}
+
+    out = tmp_path / "s1"
+    for name, cls, effects, z, verdict in (("c000", "none", [], 3.0, "inconclusive"),
+                                           ("c001", "single", ["bulldozing"], -1.0, []),
+                                           ("c002", "single", ["grousers"], 0.0, None)):
+        (out / "truth").mkdir(parents=True, exist_ok=True)
+        (out / "truth" / f"{name}.json").write_text(json.dumps(
+            {"class": cls, "effects": effects, "outside": []}))
+        if verdict is not None:
+            (out / name).mkdir()
+            (out / name / "gap.json").write_text(json.dumps(
+                {"verdict": verdict, "points": [point(z), point(z)]}))
+    rows = misfits([out])
+    assert [(r["campaign"], r["rms"], r["wrong_none"]) for r in rows] == [
+        ("s1/c000", pytest.approx(3.0), False), ("s1/c001", pytest.approx(1.0), True)]
+    text = summary(rows)
+    assert "| none | 1 | 3.0 | 3.0 | 3.0 | 3.0 |" in text and "s1/c001 (single) 1.0" in text
