@@ -3,7 +3,7 @@ docs/gap-report.md): each source's leading effect sets with their probabilities,
 rate, the verdict and, where a lugged and a smooth wheel ran on one soil, the measured
 contrast of drawbar pull with its 95 % interval.
 
-``python -m bench gap_real [--markdown]`` (about 3 min on two cores); the record is
+``python -m bench gap_real [--markdown]`` (about 10 s); the record is
 docs/validation/gap_real.md. The CMU example needs ``../shared/data`` (skipped without it).
 None of these data were used to build the diagnosis; they are independent of it.
 """
