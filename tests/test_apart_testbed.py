@@ -433,3 +433,34 @@ def test_misfit_after_soil_recalibration_per_class(tmp_path):
         ("s1/c000", pytest.approx(3.0), False), ("s1/c001", pytest.approx(1.0), True)]
     text = summary(rows)
     assert "| none | 1 | 3.0 | 3.0 | 3.0 | 3.0 |" in text and "s1/c001 (single) 1.0" in text
+
+
+def test_paired_comparison_of_two_diagnoses_of_the_same_campaigns():
+    """Hand-made score rows of three campaigns diagnosed twice: a single called rightly by
+    both, a no-effect campaign that becomes a call, a rig artefact read as no missing effect
+    that becomes "outside the candidates"; the figures counted by hand."""
+    from testbeds.apart.compare import changed, figures, markdown
+
+    def row(name, cls, leading, p, outcome, p_true, effects=(), outside=()):
+        return {"campaign": name, "class": cls, "effects": list(effects),
+                "outside": list(outside), "leading": leading, "p_leading": p,
+                "outcome": outcome, "p_true": p_true}
+
+    single = row("s1/c000", "single", "grousers", 0.95, "right", 0.95, ["grousers"])
+    before = [single, row("s1/c001", "none", "none", 0.6, "inconclusive", 0.6),
+              row("s1/c002", "outside", "none", 0.93, "wrong", 0.05, outside=["rig_artefact"])]
+    after = [single, row("s1/c001", "none", "none", 0.92, "right", 0.92),
+             row("s1/c002", "outside", "outside_candidates", 0.7, "right", 0.7,
+                 outside=["rig_artefact"])]
+    a, b = figures(before), figures(after)
+    assert a["confidently wrong"].startswith("1 ") and b["confidently wrong"].startswith("0 ")
+    assert (a["right on none and singles"], b["right on none and singles"]) == ("1/2", "2/2")
+    assert (a["outside not named as one of the six"],
+            b["outside not named as one of the six"]) == ("0/1", "1/1")
+    assert float(a["mean log loss of the truth (nats)"]) == pytest.approx(
+        -(np.log(0.95) + np.log(0.6) + np.log(0.05)) / 3, abs=5e-4)
+    assert float(b["mean log loss of the truth (nats)"]) == pytest.approx(
+        -(np.log(0.95) + np.log(0.92) + np.log(0.7)) / 3, abs=5e-4)
+    assert [r["campaign"] for r, _ in changed(before, after)] == ["s1/c001", "s1/c002"]
+    assert "| s1/c002 | none + outside: rig_artefact | none 0.93 (wrong) | " \
+           "outside_candidates 0.70 (right) |" in markdown(before, after)

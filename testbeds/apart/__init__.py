@@ -11,4 +11,5 @@ layer. An import contract (pyproject.toml) keeps it from ``terramechanics``, ``s
     python -m testbeds.apart.score /tmp/apart --jobs 2
     python -m testbeds.apart.followup /tmp/apart --out /tmp/followup
     python -m testbeds.apart.misfit /tmp/apart
+    python -m testbeds.apart.compare before.json after.json
 """
