@@ -11,7 +11,7 @@ import json
 import sys
 from pathlib import Path
 
-from testbeds.apart.score import calibration
+from testbeds.apart.score import calibration, truth_label
 
 
 def _fraction(pair: list[int]) -> str:
@@ -54,11 +54,8 @@ def markdown(before: list[dict], after: list[dict]) -> str:
     moved = changed(before, after)
     if moved:
         lines += ["", "| campaign | truth | before | after |", "|---|---|---|---|"]
-        for r, s in moved:
-            truth = "+".join(r["effects"]) or "none"
-            if r["outside"]:
-                truth += " + outside: " + ", ".join(r["outside"])
-            lines.append(f"| {r['campaign']} | {truth} | {_lead(r)} | {_lead(s)} |")
+        lines += [f"| {r['campaign']} | {truth_label(r)} | {_lead(r)} | {_lead(s)} |"
+                  for r, s in moved]
     return "\n".join(lines)
 
 

@@ -260,7 +260,8 @@ def summarise(rows: list[dict]) -> dict:
             "campaigns": rows}
 
 
-def _label(r: dict) -> str:
+def truth_label(r: dict) -> str:
+    """A campaign's truth in words: its effects of the six, and those outside them."""
     six = "+".join(r["effects"]) or "none"
     return six + (" + outside: " + "+".join(r["outside"]) if r["outside"] else "")
 
@@ -273,7 +274,7 @@ def markdown(result: dict) -> str:
         verdict = (r["failed"] and f"failed: {r['failed'][:60]}") or (
             r["verdict"] if isinstance(r["verdict"], str) else "+".join(r["verdict"]) or "none")
         lead = "-" if r["p_leading"] is None else f"{r['leading']} ({r['p_leading']:.2f})"
-        lines.append(f"| {r['campaign']} | {_label(r)} | {r['runs']} ({r['sources']}) | "
+        lines.append(f"| {r['campaign']} | {truth_label(r)} | {r['runs']} ({r['sources']}) | "
                      f"{verdict} | {r['chosen'] or '-'} | {lead} | {r['outcome']} |")
     lines += ["", "| class | n | right | inconclusive | wrong | failed | chosen = truth's six |",
               "|---|---|---|---|---|---|---|"]
@@ -357,7 +358,7 @@ def main(argv: list[str] | None = None) -> int:
         print(markdown(result))
     else:
         for r in result["campaigns"]:
-            print(f"{r['campaign']}: truth {_label(r)}; verdict {r['verdict'] or r['failed']}"
+            print(f"{r['campaign']}: truth {truth_label(r)}; verdict {r['verdict'] or r['failed']}"
                   f" -> {r['outcome']}")
         for cls, v in result["by_class"].items():
             if v["n"]:
