@@ -27,10 +27,13 @@ def test_a_towed_torque_of_zero_is_warned_about(tmp_path, slip, torque):
                   f"a,0.15,0.16,80,{slip},-6.5,0.5,{torque},0.1")
     with pytest.warns(TowedTorqueWarning) as caught:
         table = read_points_csv(path)
-    assert len(caught) == 1
-    assert str(caught[0].message).startswith(f"{path}:3: column 'torque_nm': exactly 0 on a "
-                                             f"towed row (slip {float(slip):g} <= 0)")
-    assert "leave the cell (and its _se or _sd) blank" in str(caught[0].message)
+    # only the reader's warnings: a warning of another module's object collected meanwhile
+    # (seen once under xdist) is recorded too
+    towed = [w for w in caught if issubclass(w.category, TowedTorqueWarning)]
+    assert len(towed) == 1, [(w.category.__name__, str(w.message)) for w in caught]
+    assert str(towed[0].message).startswith(f"{path}:3: column 'torque_nm': exactly 0 on a "
+                                            f"towed row (slip {float(slip):g} <= 0)")
+    assert "leave the cell (and its _se or _sd) blank" in str(towed[0].message)
     assert table["torque_nm"].tolist() == [3.0, 0.0]  # still read as written
 
 
