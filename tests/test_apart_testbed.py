@@ -302,6 +302,30 @@ def test_scorer_reads_verdicts_and_probabilities(tmp_path, effects, outside, rep
     assert row["p_true"] == (pytest.approx(p_true) if p_true is not None else None)
 
 
+def test_where_the_probability_of_a_truth_of_the_six_goes(tmp_path):
+    """A single (grousers) whose probability is split, by hand: 0.5 on it (two laws), 0.2 on
+    a pair holding it, 0.1 on none, 0.05 on another single, 0.15 outside; the mean over
+    two campaigns per class, and none for a truth outside the six."""
+    from testbeds.apart.score import calibration, calibration_markdown, score_campaign
+
+    report = {"verdict": "inconclusive", "probabilities": {
+        "grousers(ding2011)": 0.3, "grousers(bekker1956)": 0.2,
+        "grousers+multipass": 0.2, "soil_only": 0.1, "slip_sinkage(lyasko2010)": 0.05,
+        "outside_candidates": 0.15}}
+    (tmp_path / "gap.json").write_text(json.dumps(report))
+    row = score_campaign(tmp_path, _truth("c000", ["grousers"]))
+    assert row["p_where"] == pytest.approx(
+        {"truth": 0.5, "larger": 0.2, "smaller": 0.1, "other": 0.05, "outside": 0.15})
+    other = score_campaign(tmp_path, _truth("c001", ["multipass"]))
+    assert other["p_where"] == pytest.approx(
+        {"truth": 0.0, "larger": 0.2, "smaller": 0.1, "other": 0.55, "outside": 0.15})
+    assert "p_where" not in score_campaign(tmp_path, _truth("c002", [], ["rate_effect"]))
+    cal = calibration([row, other])
+    assert cal["where"]["single"] == pytest.approx(
+        {"n": 2, "truth": 0.25, "larger": 0.2, "smaller": 0.1, "other": 0.3, "outside": 0.15})
+    assert "| single | 2 | 0.25 | 0.20 | 0.10 | 0.30 | 0.15 |" in calibration_markdown(cal)
+
+
 def test_scorer_counts_a_failed_step(tmp_path):
     from testbeds.apart.score import score_campaign
 

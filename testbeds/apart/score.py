@@ -133,6 +133,21 @@ def probabilities(report: dict) -> dict[tuple[str, ...] | str, float]:
     return out
 
 
+#: how a hypothesis stands to a truth of the six (:func:`relation`)
+RELATIONS = ("truth", "larger", "smaller", "other", "outside")
+
+
+def relation(key: tuple[str, ...] | str, truth_set: tuple[str, ...]) -> str:
+    """How the hypothesis ``key`` (an effect set, or a label naming no set) stands to the
+    truth's effect set: the truth itself, a larger set holding it (an effect too many), a
+    smaller set within it (an effect missed), another set, or outside the candidates."""
+    if isinstance(key, str):
+        return "outside"
+    have, want = set(key), set(truth_set)
+    return ("truth" if have == want else "larger" if want < have
+            else "smaller" if have < want else "other")
+
+
 def score_campaign(folder: Path, truth: dict) -> dict:
     """One row: the truth, the verdict, the outcome and the probabilities read."""
     row = {"campaign": truth["campaign"], "class": truth["class"],
@@ -167,6 +182,11 @@ def score_campaign(folder: Path, truth: dict) -> dict:
         row["leading"] = "+".join(leading) or "none" if isinstance(leading, tuple) else leading
         row["p_leading"] = probs[leading]
         row["p_true"] = probs.get("outside_candidates" if truth["outside"] else truth_set, 0.0)
+        if not truth["outside"]:
+            where = dict.fromkeys(RELATIONS, 0.0)
+            for key, p in probs.items():
+                where[relation(key, truth_set)] += p
+            row["p_where"] = where
     return row
 
 
@@ -219,8 +239,15 @@ def calibration(rows: list[dict]) -> dict:
                              "stated": float(np.mean([r["p_leading"] for r in sub])),
                              "right": float(np.mean([bool(leading_is_right(r))
                                                      for r in sub]))}
+    where = {}
+    for cls in CLASSES:
+        sub = [r["p_where"] for r in scored if r["class"] == cls and r.get("p_where")]
+        if sub:
+            where[cls] = {"n": len(sub)} | {k: float(np.mean([w[k] for w in sub]))
+                                            for k in RELATIONS}
     p_true = np.array([r["p_true"] for r in scored], float)
-    return {"bins": bins, "by_class": by_class, "confident_wrong": wrong, "n": n,
+    return {"bins": bins, "by_class": by_class, "where": where,
+            "confident_wrong": wrong, "n": n,
             "log_loss": float(np.mean(-np.log(np.maximum(p_true, P_FLOOR)))) if scored else None,
             "confident_wrong_upper_95": upper_95(wrong, n),
             "right_none_and_singles": rate(("none", "single"), "right"),
@@ -297,6 +324,15 @@ def calibration_markdown(cal: dict) -> str:
               "|---|---|---|---|"]
     lines += [f"| {cls} | {v['n']} | {v['stated']:.2f} | {v['right']:.2f} |"
               for cls, v in cal["by_class"].items()]
+
+    if cal.get("where"):
+        lines += ["", "Where the probability goes (mean per class of the truth): the truth's "
+                  "effect set, larger sets holding it (an effect too many), smaller ones within "
+                  "it (an effect missed), other sets, outside the candidates.", "",
+                  "| class of the truth | campaigns | " + " | ".join(RELATIONS) + " |",
+                  "|---|---|" + "---|" * len(RELATIONS)]
+        lines += [f"| {cls} | {v['n']} | " + " | ".join(f"{v[k]:.2f}" for k in RELATIONS)
+                  + " |" for cls, v in cal["where"].items()]
 
     def frac(pair):
         k, n = pair
