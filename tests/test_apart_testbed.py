@@ -323,6 +323,8 @@ def test_where_the_probability_of_a_truth_of_the_six_goes(tmp_path):
     cal = calibration([row, other])
     assert cal["where"]["single"] == pytest.approx(
         {"n": 2, "truth": 0.25, "larger": 0.2, "smaller": 0.1, "other": 0.3, "outside": 0.15})
+    assert cal["where"]["single: grousers"] == pytest.approx({"n": 1, **row["p_where"]})
+    assert cal["where"]["single: multipass"] == pytest.approx({"n": 1, **other["p_where"]})
     assert "| single | 2 | 0.25 | 0.20 | 0.10 | 0.30 | 0.15 |" in calibration_markdown(cal)
 
 

@@ -239,12 +239,15 @@ def calibration(rows: list[dict]) -> dict:
                              "stated": float(np.mean([r["p_leading"] for r in sub])),
                              "right": float(np.mean([bool(leading_is_right(r))
                                                      for r in sub]))}
+    groups = [(cls, lambda r, cls=cls: r["class"] == cls) for cls in CLASSES] + [
+        (f"single: {e}", lambda r, e=e: r["class"] == "single" and r["effects"] == [e])
+        for e in SIX]
     where = {}
-    for cls in CLASSES:
-        sub = [r["p_where"] for r in scored if r["class"] == cls and r.get("p_where")]
+    for name, member in groups:
+        sub = [r["p_where"] for r in scored if member(r) and r.get("p_where")]
         if sub:
-            where[cls] = {"n": len(sub)} | {k: float(np.mean([w[k] for w in sub]))
-                                            for k in RELATIONS}
+            where[name] = {"n": len(sub)} | {k: float(np.mean([w[k] for w in sub]))
+                                             for k in RELATIONS}
     p_true = np.array([r["p_true"] for r in scored], float)
     return {"bins": bins, "by_class": by_class, "where": where,
             "confident_wrong": wrong, "n": n,
@@ -326,9 +329,10 @@ def calibration_markdown(cal: dict) -> str:
               for cls, v in cal["by_class"].items()]
 
     if cal.get("where"):
-        lines += ["", "Where the probability goes (mean per class of the truth): the truth's "
-                  "effect set, larger sets holding it (an effect too many), smaller ones within "
-                  "it (an effect missed), other sets, outside the candidates.", "",
+        lines += ["", "Where the probability goes (mean per class of the truth, and per effect "
+                  "of a single): the truth's effect set, larger sets holding it (an effect too "
+                  "many), smaller ones within it (an effect missed), other sets, outside the "
+                  "candidates.", "",
                   "| class of the truth | campaigns | " + " | ".join(RELATIONS) + " |",
                   "|---|---|" + "---|" * len(RELATIONS)]
         lines += [f"| {cls} | {v['n']} | " + " | ".join(f"{v[k]:.2f}" for k in RELATIONS)
