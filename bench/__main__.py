@@ -5,7 +5,9 @@ its own table and returns its numbers; the numbers of a run are written to
 ``bench/results/<name>.json`` for comparison between commits. ``--markdown``: a benchmark
 with ``markdown(numbers) -> str`` also writes ``docs/validation/<name>.md``, under its title
 the line naming the release and the command (:func:`provenance`, which
-tests/test_validation_records.py reads).
+tests/test_validation_records.py reads). A benchmark module with ``ON_PINNED_ISA = True``
+runs in a child process on one instruction set (:mod:`bench.pinned_isa`): its figures count
+verdicts at a threshold, which the last bits of another machine's kernels can turn.
 """
 
 from __future__ import annotations
@@ -13,11 +15,16 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import os
 import pkgutil
+import subprocess
+import sys
 import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 
 import bench
+from bench.pinned_isa import is_pinned, pinned_env
 from swtlab_base.atomic import write_atomically
 
 
@@ -37,6 +44,15 @@ def page(name: str, markdown: str) -> str:
     return f"{title}\n\n{provenance(name)}\n{rest}"
 
 
+def pinned_child(name: str, module, options: list[str],
+                 environ: Mapping[str, str] = os.environ) -> tuple[list[str], dict] | None:
+    """The command and environment that run benchmark ``name`` (with ``options``) on the
+    pinned instruction set, when its module asks for it and this process is not on it."""
+    if not getattr(module, "ON_PINNED_ISA", False) or is_pinned(environ):
+        return None
+    return [sys.executable, "-m", "bench", name, *options], pinned_env(environ)
+
+
 def main() -> None:
     names = sorted(m.name[len("bench_"):] for m in pkgutil.iter_modules(bench.__path__)
                    if m.name.startswith("bench_"))
@@ -54,6 +70,13 @@ def main() -> None:
     for name in args.names or names:
         print(f"== bench {name}")
         module = importlib.import_module(f"bench.bench_{name}")
+        child = pinned_child(name, module, ["--quick"] * args.quick
+                             + ["--markdown"] * args.markdown)
+        if child is not None:
+            print("on the pinned instruction set (bench/pinned_isa.py), in a child process",
+                  flush=True)
+            subprocess.run(child[0], env=child[1], cwd=ROOT, check=True)
+            continue
         numbers = module.main(quick=args.quick)
         (out / f"{name}.json").write_text(json.dumps(numbers, indent=2, default=float))
         if args.markdown and hasattr(module, "markdown"):

@@ -46,6 +46,11 @@ the run, on a second change (an outside effect as weak as the candidates can be)
 dropped; they are seen. The next fresh seeds are 16001-16013. 0.15.0's seeds
 2001-2013 had been seen by that release. A later change to the diagnosis makes these seen
 too: name new fresh seeds here then.
+
+The bench runs on the pinned instruction set (:data:`ON_PINNED_ISA`, bench/pinned_isa.py):
+on the same 208 campaigns, an AVX-512 machine's own kernels moved 8 leading probabilities
+by up to 0.16 and turned 6 outcomes (docs/validation/gap-apart.md, "The same campaigns on
+two instruction sets"), so a record made on one machine could not be repeated on another.
 """
 
 from __future__ import annotations
@@ -57,6 +62,8 @@ from pathlib import Path
 
 from testbeds.apart import campaigns, score
 
+#: run by ``python -m bench`` on the pinned instruction set (module docstring)
+ON_PINNED_ISA = True
 #: fresh seeds of the calibration (module docstring)
 FRESH_SEEDS = tuple(range(13001, 13014))
 CAMPAIGNS_PER_SEED = 16

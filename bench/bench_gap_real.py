@@ -31,6 +31,9 @@ EXAMPLES = {
     "CMU smooth wheel (triplicates)": (
         [CMU_RUNS], ROOT / "sim_gap/models/cmu_smooth_sand.toml", None),
 }
+#: run by ``python -m bench`` on the pinned instruction set (bench/pinned_isa.py): its
+#: figures are verdicts at a threshold
+ON_PINNED_ISA = True
 N_BOOT = 50
 LEADERS = 3
 

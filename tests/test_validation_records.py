@@ -83,3 +83,25 @@ def test_a_record_without_its_release_or_with_a_wrong_command_is_named(tmp_path)
         "unreleased.md": ["release 9.9.9 is not in CHANGELOG.md"],
         "wpm.md": ["python -m bench coverage --markdown does not write wpm.md"],
         "gone.md": ["no module testbeds.nowhere"]}
+
+
+def test_a_bench_on_the_pinned_instruction_set_runs_in_a_child_on_it():
+    """A bench whose module asks for the pinned instruction set runs as ``python -m bench NAME
+    [options]`` with bench/pinned_isa.py's environment, once: not again from inside the
+    child, and not for a bench that does not ask."""
+    import platform
+    import types
+
+    from bench.__main__ import pinned_child
+    from bench.pinned_isa import MARKER, PINNED_ISA
+
+    asks, plain = types.SimpleNamespace(ON_PINNED_ISA=True), types.SimpleNamespace()
+    command, env = pinned_child("gap_calibration", asks, ["--markdown"], {"HOME": "/h"})
+    assert command[1:] == ["-m", "bench", "gap_calibration", "--markdown"]
+    x86 = platform.machine() in ("x86_64", "AMD64")
+    assert env == {"HOME": "/h", MARKER: "1", **(PINNED_ISA if x86 else {})}
+    assert pinned_child("gap_calibration", asks, [], env) is None
+    assert pinned_child("wpm", plain, [], {"HOME": "/h"}) is None
+    for name in ("gap_calibration", "gap_real", "gap_blind"):
+        module = importlib.import_module(f"bench.bench_{name}")
+        assert module.ON_PINNED_ISA is True

@@ -15,11 +15,9 @@ A commit that means to change a number regenerates them, in the repository root,
 and commits the changed files with the change (``git diff`` shows what moved).
 ``tests/test_reference_sample.py`` checks the code against them.
 
-Both compute in a child process on one pinned instruction set (:data:`PINNED_ISA`): NumPy's
-AVX-512 kernels, OpenBLAS' per-CPU kernels, Numba's host target and OpenCV's AVX-512 kernels
-otherwise round the last bits differently from machine to machine, and an optimiser that
-stops a few ulps elsewhere can move a stable window by one sample (seen: 6 of the 60 sample
-runs between an AVX-512 machine and an AVX2 one).
+Both compute in a child process on one pinned instruction set
+(:mod:`bench.pinned_isa`): the last bits of NumPy, OpenBLAS, Numba and OpenCV otherwise differ
+from machine to machine, and a stable window can move by one sample.
 """
 
 from __future__ import annotations
@@ -30,13 +28,13 @@ import csv
 import io
 import json
 import math
-import os
-import platform
 import sqlite3
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from bench.pinned_isa import pinned_env
 
 ROOT = Path(__file__).resolve().parents[2]
 CAMPAIGN = ROOT / "sample_data" / "campaign"
@@ -48,13 +46,6 @@ UNSTABLE_KEYS = {"swtlab_version", "version", "created", "created_at"}
 #: numbers agree to this relative tolerance: the same code on another CPU or BLAS may sum in
 #: another order (last bits); a change a commit means is many orders larger
 REL_TOL = 1e-9
-#: one x86-64 code path on every machine with AVX2: NumPy's AVX-512 dispatch targets off
-#: (names as NumPy 2.4 knows them), OpenBLAS' Haswell kernels on one thread, Numba for
-#: Haswell, OpenCV without AVX-512 (its AVX512_SKX kernels need AVX512F; on a machine
-#: without it OpenCV says on stderr that there is nothing to disable)
-PINNED_ISA = {"NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL AVX512_SPR",
-              "OPENBLAS_CORETYPE": "Haswell", "OPENBLAS_NUM_THREADS": "1",
-              "NUMBA_CPU_NAME": "haswell", "OPENCV_CPU_DISABLE": "AVX512F"}
 
 
 def _cli(*argv: str) -> None:
@@ -116,20 +107,14 @@ def sqlite_copy(source: Path, target: Path) -> None:
         a.backup(b)
 
 
-def _pinned() -> dict[str, str]:
-    """:data:`PINNED_ISA` on x86-64; nothing elsewhere (its names are x86 ones, and the stored
-    reference is an x86-64 one)."""
-    return PINNED_ISA if platform.machine() in ("x86_64", "AMD64") else {}
-
-
 def pinned_outputs(names: tuple[str, ...] = NAMES,
                    keep_db: Path | None = None) -> dict[str, str]:
     """:func:`outputs` of the sample campaign processed afresh, computed in a child process
-    on :data:`PINNED_ISA`; ``keep_db``: where to keep a copy of the processed database as it
-    was before the outputs were made."""
+    on the pinned instruction set; ``keep_db``: where to keep a copy of the processed
+    database as it was before the outputs were made."""
     keep = [] if keep_db is None else ["--keep-db", str(keep_db)]
     done = subprocess.run([sys.executable, "-m", "tests.reference.regenerate", "--print",
-                           *keep, *names], cwd=ROOT, env={**os.environ, **_pinned()},
+                           *keep, *names], cwd=ROOT, env=pinned_env(),
                           capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(f"the pinned reference run failed:\n{done.stderr[-3000:]}")
