@@ -4,7 +4,7 @@ against their truths: the reliability of the stated probabilities by decile, con
 wrong calls with their 95 % upper bound, the log loss, and the issue's rates.
 
 ``python -m bench gap_calibration [--markdown]``: the 13 seeds of :data:`FRESH_SEEDS`, 16
-campaigns each (208), about 35 min on two idle cores; ``--quick``: 10 campaigns of the first
+campaigns each (208), 20-35 min on two idle cores; ``--quick``: 10 campaigns of the first
 seed. Environment ``GAP_CALIBRATION_DIR`` keeps the campaigns (default: a temporary folder;
 a kept folder is diagnosed again, not regenerated), ``GAP_CALIBRATION_JOBS`` (default 2).
 
