@@ -85,6 +85,7 @@ def run(folder: Path, seeds: tuple[int, ...], n: int, jobs: int) -> dict:
                + (["--regap"] if processed else []))
     result = score.summarise([r for o in outs for r in score.score(o)["campaigns"]])
     result["seconds"] = time.perf_counter() - start
+    result["diagnosed_only"] = processed
     result["seeds"] = list(seeds)
     return result
 
@@ -111,7 +112,9 @@ def markdown(numbers: dict) -> str:
              "[gap-apart.md](gap-apart.md). Seeds "
              f"{numbers['seeds'][0]}-{numbers['seeds'][-1]}, {numbers['n']} campaigns, "
              "fresh (never tuned on), raw runs through `swtlab process` and `swtlab gap`; "
-             f"{numbers['seconds'] / 60:.0f} min at the bench's two jobs.", "",
+             f"{numbers['seconds'] / 60:.0f} min at the bench's two jobs"
+             + (" (diagnosis only: the campaigns were kept, made and processed by an earlier "
+                "run)" if numbers.get("diagnosed_only") else "") + ".", "",
              "| class | campaigns | right | inconclusive | confidently wrong | failed |",
              "|---|---|---|---|---|---|"]
     for cls, v in numbers["by_class"].items():

@@ -325,7 +325,12 @@ def test_where_the_probability_of_a_truth_of_the_six_goes(tmp_path):
         {"n": 2, "truth": 0.25, "larger": 0.2, "smaller": 0.1, "other": 0.3, "outside": 0.15})
     assert cal["where"]["single: grousers"] == pytest.approx({"n": 1, **row["p_where"]})
     assert cal["where"]["single: multipass"] == pytest.approx({"n": 1, **other["p_where"]})
-    assert "| single | 2 | 0.25 | 0.20 | 0.10 | 0.30 | 0.15 |" in calibration_markdown(cal)
+    assert "| single | 2 | 0.25 | 0.20 | 0.10 | 0.30 | 0.15 | - |" in calibration_markdown(cal)
+    with_d = calibration([{**row, "distances": {"grousers": 12.0}},
+                          {**row, "distances": {"grousers": 30.0}}])
+    assert with_d["where"]["single: grousers"]["median_d"] == pytest.approx(21.0)
+    assert "| single: grousers | 2 | 0.50 | 0.20 | 0.10 | 0.05 | 0.15 | 21 |" in \
+        calibration_markdown(with_d)
 
 
 def test_scorer_counts_a_failed_step(tmp_path):

@@ -239,15 +239,21 @@ def calibration(rows: list[dict]) -> dict:
                              "stated": float(np.mean([r["p_leading"] for r in sub])),
                              "right": float(np.mean([bool(leading_is_right(r))
                                                      for r in sub]))}
-    groups = [(cls, lambda r, cls=cls: r["class"] == cls) for cls in CLASSES] + [
-        (f"single: {e}", lambda r, e=e: r["class"] == "single" and r["effects"] == [e])
-        for e in SIX]
+    groups: dict[str, list[dict]] = {}
+    for r in scored:
+        if r.get("p_where"):
+            groups.setdefault(r["class"], []).append(r)
+            if r["class"] == "single":
+                groups.setdefault(f"single: {r['effects'][0]}", []).append(r)
+    order = [*CLASSES, *(f"single: {e}" for e in SIX)]
     where = {}
-    for name, member in groups:
-        sub = [r["p_where"] for r in scored if member(r) and r.get("p_where")]
-        if sub:
-            where[name] = {"n": len(sub)} | {k: float(np.mean([w[k] for w in sub]))
-                                             for k in RELATIONS}
+    for name in (g for g in order if g in groups):
+        sub = groups[name]
+        where[name] = {"n": len(sub)} | {k: float(np.mean([r["p_where"][k] for r in sub]))
+                                         for k in RELATIONS}
+        if name.startswith("single: ") and all("distances" in r for r in sub):
+            where[name]["median_d"] = float(np.median(
+                [r["distances"][r["effects"][0]] for r in sub]))
     p_true = np.array([r["p_true"] for r in scored], float)
     return {"bins": bins, "by_class": by_class, "where": where,
             "confident_wrong": wrong, "n": n,
@@ -333,10 +339,12 @@ def calibration_markdown(cal: dict) -> str:
                   "of a single): the truth's effect set, larger sets holding it (an effect too "
                   "many), smaller ones within it (an effect missed), other sets, outside the "
                   "candidates.", "",
-                  "| class of the truth | campaigns | " + " | ".join(RELATIONS) + " |",
-                  "|---|---|" + "---|" * len(RELATIONS)]
+                  "| class of the truth | campaigns | " + " | ".join(RELATIONS)
+                  + " | median D of the effect (design check) |",
+                  "|---|---|" + "---|" * (len(RELATIONS) + 1)]
         lines += [f"| {cls} | {v['n']} | " + " | ".join(f"{v[k]:.2f}" for k in RELATIONS)
-                  + " |" for cls, v in cal["where"].items()]
+                  + (f" | {v['median_d']:,.0f} |" if "median_d" in v else " | - |")
+                  for cls, v in cal["where"].items()]
 
     def frac(pair):
         k, n = pair
